@@ -1,0 +1,40 @@
+// Checks of mesh validity: of raw input triangles before a Mesh is built, and of a built Mesh's topology and
+// per-element state after edits.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+
+namespace arcsim {
+
+// Raw triangle soup as read from a file. vert_node[k] is the node of rest vertex k; tris hold vert indices.
+// `tri_source_line[t]` (optional) is the file line of triangle t, used in messages.
+struct TriangleInput {
+  size_t node_count = 0;
+  std::vector<int> vert_node;
+  std::vector<Vec3> vert_u;
+  std::vector<std::array<int, 3>> tris;
+  std::vector<int> tri_source_line;
+};
+
+// Throws InputError ("<file>:<line>: <problem>" or "<file>: <problem> (node N)") on the first of: index out of
+// range, degenerate face (a node repeated), zero-area face in rest space, duplicate face, non-manifold edge
+// (more than two faces), inconsistent orientation (two faces run an edge the same way), non-manifold vertex
+// (its faces form more than one fan), node referenced by no face. Node and face numbers in messages are
+// 1-based, as in the OBJ file.
+void validate_triangles(const TriangleInput& in, const std::string& file);
+
+// Returns "" if the mesh is consistent, else a one-line description of the first problem, naming the element:
+// live elements only reference live elements; adjacency lists agree both ways; each edge has 1 or 2 faces with
+// the orientation convention of mesh.hpp; every node's faces form one fan (manifold); no degenerate faces;
+// optionally every face has positive rest area and all per-element state is finite.
+struct MeshCheckOptions {
+  bool require_positive_rest_area = true;
+  bool require_finite_state = true;
+};
+std::string check_mesh(const Mesh& mesh, const MeshCheckOptions& options = {});
+
+}  // namespace arcsim
