@@ -57,6 +57,7 @@ Mesh Mesh::from_triangles(const std::vector<Vec3>& node_x, const std::vector<Vec
 
 int Mesh::add_node(const Node& n) {
   nodes.push_back(n);
+  nodes.back().dead = false;  // the prototype may be a removed element
   nodes.back().verts.clear();
   nodes.back().edges.clear();
   return static_cast<int>(nodes.size()) - 1;
@@ -65,6 +66,7 @@ int Mesh::add_node(const Node& n) {
 int Mesh::add_vert(const Vert& v, int node) {
   verts.push_back(v);
   Vert& nv = verts.back();
+  nv.dead = false;
   nv.faces.clear();
   nv.node = node;
   const int index = static_cast<int>(verts.size()) - 1;
@@ -93,7 +95,16 @@ int Mesh::get_or_add_edge(int n0, int n1) {
 }
 
 int Mesh::add_face(const std::array<int, 3>& v, const Face& prototype) {
+  // Check everything before linking anything, so that a refused face leaves the mesh unchanged.
+  for (int i = 0; i < 3; ++i) {
+    const int a = verts[v[i]].node, b = verts[v[(i + 1) % 3]].node;
+    if (a == b) throw std::logic_error("add_face: degenerate face (a node repeated)");
+    const int e = find_edge(a, b);
+    if (e != kNone && edges[e].f[edges[e].n[0] == a ? 0 : 1] != kNone)
+      throw std::logic_error("add_face: edge side already taken (non-manifold or inconsistently oriented)");
+  }
   Face f = prototype;
+  f.dead = false;  // the prototype may be a removed face
   f.v = v;
   faces.push_back(f);
   const int index = static_cast<int>(faces.size()) - 1;
@@ -103,10 +114,7 @@ int Mesh::add_face(const std::array<int, 3>& v, const Face& prototype) {
     const int e = get_or_add_edge(a, b);
     faces[index].e[i] = e;
     // The face runs a -> b; it is f[0] if the edge is stored as a -> b.
-    const int side = (edges[e].n[0] == a) ? 0 : 1;
-    if (edges[e].f[side] != kNone && edges[e].f[side] != index)
-      throw std::logic_error("add_face: edge side already taken (non-manifold or inconsistently oriented)");
-    edges[e].f[side] = index;
+    edges[e].f[edges[e].n[0] == a ? 0 : 1] = index;
   }
   return index;
 }

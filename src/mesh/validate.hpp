@@ -34,7 +34,19 @@ void validate_triangles(const TriangleInput& in, const std::string& file);
 struct MeshCheckOptions {
   bool require_positive_rest_area = true;
   bool require_finite_state = true;
+  // Derived rest data (rest_area, rest_normal) matches the rest vertices, i.e. update_rest_data ran after the
+  // last edit or rest-shape change. Switch off while rest positions are being changed in bulk.
+  bool require_current_rest_data = true;
 };
 std::string check_mesh(const Mesh& mesh, const MeshCheckOptions& options = {});
+
+// A rest triangle counts as degenerate (zero area) when twice its area is at most this fraction of its longest
+// edge squared (about the sine of its smallest angle): the scale-free test shared by validate_triangles,
+// check_mesh and the topology edits, so that no edit creates a face the checks reject.
+constexpr double kDegenerateRelativeArea = 1e-12;
+bool rest_triangle_degenerate(const Vec3& u0, const Vec3& u1, const Vec3& u2);
+
+// Number of connected pieces of the sheet: live faces joined through shared (interior) edges.
+int count_components(const Mesh& mesh);
 
 }  // namespace arcsim

@@ -1,0 +1,121 @@
+#include "physics/block_system.hpp"
+
+#include <algorithm>
+#include <atomic>
+
+namespace arcsim {
+
+namespace {
+std::atomic<uint64_t> next_pattern_id{1};
+}
+
+void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs) {
+  node_count_ = node_count;
+  for (auto& p : pairs)
+    if (p.first < p.second) std::swap(p.first, p.second);  // (row, col) with row >= col
+  for (int i = 0; i < node_count; ++i) pairs.emplace_back(i, i);
+  // Column-major order: by column, then row.
+  std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second < b.second : a.first < b.first;
+  });
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+
+  block_row_.resize(pairs.size());
+  block_col_.resize(pairs.size());
+  col_start_.assign(node_count + 1, 0);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    block_row_[k] = pairs[k].first;
+    block_col_[k] = pairs[k].second;
+    ++col_start_[pairs[k].second + 1];
+  }
+  for (int c = 0; c < node_count; ++c) col_start_[c + 1] += col_start_[c];
+
+  // Scalar CSC of the lower triangle: column 3c+b holds, for each block (r, c) of node column c in row order,
+  // rows 3r..3r+2 (or 3c+b..3c+2 for the diagonal block).
+  const int n = 3 * node_count;
+  std::vector<int> outer(n + 1, 0);
+  for (int c = 0; c < node_count; ++c) {
+    const int blocks_in_col = col_start_[c + 1] - col_start_[c];  // includes the diagonal block
+    for (int b = 0; b < 3; ++b) outer[3 * c + b + 1] = 3 * (blocks_in_col - 1) + (3 - b);
+  }
+  for (int j = 0; j < n; ++j) outer[j + 1] += outer[j];
+  const int nnz = outer[n];
+  std::vector<int> inner(nnz);
+  value_offset_.assign(3 * pairs.size(), 0);
+  for (int c = 0; c < node_count; ++c) {
+    for (int b = 0; b < 3; ++b) {
+      int pos = outer[3 * c + b];
+      for (int k = col_start_[c]; k < col_start_[c + 1]; ++k) {
+        const int r = block_row_[k];
+        value_offset_[3 * k + b] = pos;
+        const int first = (r == c) ? b : 0;
+        for (int a = first; a < 3; ++a) inner[pos++] = 3 * r + a;
+      }
+    }
+  }
+  csc_.resize(n, n);
+  csc_.resizeNonZeros(nnz);
+  std::copy(outer.begin(), outer.end(), csc_.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), csc_.innerIndexPtr());
+  std::fill(csc_.valuePtr(), csc_.valuePtr() + nnz, 0.0);
+  id_ = next_pattern_id++;
+}
+
+int BlockPattern::block_index(int i, int j) const {
+  if (i < j) std::swap(i, j);
+  const auto begin = block_row_.begin() + col_start_[j], end = block_row_.begin() + col_start_[j + 1];
+  const auto it = std::lower_bound(begin, end, i);
+  return (it != end && *it == i) ? static_cast<int>(it - block_row_.begin()) : -1;
+}
+
+void BlockSystem::reset(const BlockPattern& p) {
+  pattern = &p;
+  blocks.assign(p.block_count(), Mat3::Zero());
+  rhs = VecX::Zero(3 * p.node_count());
+}
+
+VecX BlockSystem::multiply(const VecX& x) const {
+  VecX y = VecX::Zero(x.size());
+  for (int k = 0; k < pattern->block_count(); ++k) {
+    const int r = pattern->block_row(k), c = pattern->block_col(k);
+    y.segment<3>(3 * r) += blocks[k] * x.segment<3>(3 * c);
+    if (r != c) y.segment<3>(3 * c) += blocks[k].transpose() * x.segment<3>(3 * r);
+  }
+  return y;
+}
+
+void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
+  if (out.rows() != pattern->csc_structure().rows() || out.nonZeros() != pattern->csc_structure().nonZeros())
+    out = pattern->csc_structure();
+  double* values = out.valuePtr();
+  for (int k = 0; k < pattern->block_count(); ++k) {
+    const bool diagonal = pattern->block_row(k) == pattern->block_col(k);
+    for (int b = 0; b < 3; ++b) {
+      const int offset = pattern->block_value_offset(k, b);
+      for (int a = diagonal ? b : 0; a < 3; ++a) values[offset + a - (diagonal ? b : 0)] = blocks[k](a, b);
+    }
+  }
+}
+
+CholeskySolver::CholeskySolver() = default;
+CholeskySolver::~CholeskySolver() = default;
+
+bool CholeskySolver::factorize(const BlockSystem& system) {
+  const uint64_t id = system.pattern->id();
+  if (!llt_ || analysed_pattern_ != id) {
+    matrix_ = system.pattern->csc_structure();
+    system.to_csc(matrix_);
+    llt_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>();
+    llt_->analyzePattern(matrix_);
+    analysed_pattern_ = id;
+    ++analyses_;
+  } else {
+    system.to_csc(matrix_);
+  }
+  llt_->factorize(matrix_);
+  return llt_->info() == Eigen::Success;
+}
+
+VecX CholeskySolver::solve(const VecX& rhs) { return llt_->solve(rhs); }
+
+}  // namespace arcsim

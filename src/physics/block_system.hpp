@@ -1,0 +1,110 @@
+// The sparse symmetric linear system of the implicit step, over 3x3 node blocks.
+//
+// The sparsity pattern depends only on which node pairs interact (faces, hinges, and any extra pairs such as
+// contacts), so it is built once per topology and its CHOLMOD symbolic analysis is reused until it changes.
+// Element matrices are accumulated into 3x3 blocks in a fixed order (deterministic whatever the thread count),
+// then copied into the lower triangle of a compressed-column matrix that CHOLMOD factorises.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Sparse>
+
+#include "math/types.hpp"
+
+namespace arcsim {
+
+class BlockPattern {
+ public:
+  // Builds the pattern for `node_count` nodes from the node pairs that interact (any order, duplicates fine;
+  // diagonal blocks are always present).
+  void build(int node_count, std::vector<std::pair<int, int>> pairs);
+  int node_count() const { return node_count_; }
+  int block_count() const { return static_cast<int>(block_row_.size()); }
+  // Index of block (i, j) (either order); -1 if not in the pattern.
+  int block_index(int i, int j) const;
+  // Identifies the pattern: equal ids mean identical structure (symbolic factorisation can be reused).
+  uint64_t id() const { return id_; }
+
+  // Compressed-column structure of the lower triangle of the 3n x 3n matrix and, for each block, where its
+  // entries go: value index of entry (3*row + a, 3*col + b) is block_offset(k, b) + a - (diagonal ? b : 0).
+  const Eigen::SparseMatrix<double>& csc_structure() const { return csc_; }
+  int block_row(int k) const { return block_row_[k]; }
+  int block_col(int k) const { return block_col_[k]; }
+  int block_value_offset(int k, int b) const { return value_offset_[3 * k + b]; }
+
+ private:
+  int node_count_ = 0;
+  std::vector<int> col_start_;   // per node column: first block index
+  std::vector<int> block_row_;   // per block: row node (>= column node)
+  std::vector<int> block_col_;
+  std::vector<int> value_offset_;
+  Eigen::SparseMatrix<double> csc_;
+  uint64_t id_ = 0;
+};
+
+// A symmetric block matrix on a pattern plus a right-hand side.
+struct BlockSystem {
+  const BlockPattern* pattern = nullptr;
+  std::vector<Mat3> blocks;  // lower blocks (row >= col); diagonal blocks are full symmetric 3x3
+  VecX rhs;
+
+  void reset(const BlockPattern& p);
+  // Adds an element matrix over `nodes` (N nodes, 3N x 3N) scaled by `scale`. Only the lower blocks are read.
+  template <int N>
+  void add_element(const std::array<int, N>& nodes, const std::array<int, N * N>& block_ids,
+                   const Eigen::Matrix<double, 3 * N, 3 * N>& K, double scale);
+  void add_diagonal(int node, const Mat3& K) { blocks[pattern->block_index(node, node)] += K; }
+  // y = A x (full symmetric product), for tests and residuals.
+  VecX multiply(const VecX& x) const;
+  // Fills `out` (with the pattern's structure) with the lower triangle.
+  void to_csc(Eigen::SparseMatrix<double>& out) const;
+};
+
+// Looks up the block ids of all node pairs of an element once per topology.
+template <int N>
+std::array<int, N * N> element_block_ids(const BlockPattern& p, const std::array<int, N>& nodes) {
+  std::array<int, N * N> ids{};
+  for (int a = 0; a < N; ++a)
+    for (int b = 0; b < N; ++b) ids[a * N + b] = p.block_index(nodes[a], nodes[b]);
+  return ids;
+}
+
+template <int N>
+void BlockSystem::add_element(const std::array<int, N>& nodes, const std::array<int, N * N>& block_ids,
+                              const Eigen::Matrix<double, 3 * N, 3 * N>& K, double scale) {
+  for (int a = 0; a < N; ++a) {
+    for (int b = 0; b < N; ++b) {
+      // Each unordered pair once: take (a, b) where node a is the block's row (>= column).
+      if (nodes[a] < nodes[b]) continue;
+      if (nodes[a] == nodes[b] && a != b) continue;  // repeated node (degenerate element): skip safely
+      blocks[block_ids[a * N + b]] += scale * K.template block<3, 3>(3 * a, 3 * b);
+    }
+  }
+}
+
+// Sparse Cholesky (CHOLMOD, supernodal) of a BlockSystem, reusing the symbolic analysis while the pattern id
+// is unchanged.
+class CholeskySolver {
+ public:
+  CholeskySolver();
+  ~CholeskySolver();
+  // Factorises the system's matrix. Returns false if it is not positive definite or the factorisation failed.
+  bool factorize(const BlockSystem& system);
+  // Solves with the last factorisation.
+  VecX solve(const VecX& rhs);
+  int analyses() const { return analyses_; }
+
+ private:
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>> llt_;
+  Eigen::SparseMatrix<double> matrix_;
+  uint64_t analysed_pattern_ = 0;
+  int analyses_ = 0;
+};
+
+}  // namespace arcsim

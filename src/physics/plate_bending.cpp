@@ -1,0 +1,81 @@
+#include "physics/plate_bending.hpp"
+
+#include "mesh/mesh.hpp"
+#include "physics/bending.hpp"
+
+namespace arcsim {
+
+Mat3 plate_bending_matrix(const std::array<double, 3>& lengths, const std::array<Vec3, 3>& normals, double area,
+                          double kb, double nu, const std::array<bool, 3>& has_edge) {
+  Mat3 Q = Mat3::Zero();
+  if (!(area > 0)) return Q;
+  for (int i = 0; i < 3; ++i) {
+    if (!has_edge[i]) continue;
+    for (int j = 0; j < 3; ++j) {
+      if (!has_edge[j]) continue;
+      const double ci = lengths[i] / (2 * area), cj = lengths[j] / (2 * area);
+      const double dot = normals[i].dot(normals[j]);
+      Q(i, j) = 0.5 * area * kb * ci * cj * ((1 - nu) * dot * dot + nu);
+    }
+  }
+  return Q;
+}
+
+namespace {
+
+// Element slots of the hinge of edge i, in dihedral_angle's order: (c_i, c_i+1, c_i+2, w_i). The face itself is
+// the hinge's first face, in which the edge runs c_i -> c_i+1 counter-clockwise.
+std::array<int, 4> hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 + i}; }
+
+}  // namespace
+
+PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
+                                      const Vec3& rest_theta, const Mat3& Q, HessianKind hessian) {
+  PlateBendingTerms out;
+  std::array<Vec12, 3> grad;
+  Vec3 delta = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    grad[i].setZero();
+    if (!has_wing[i]) continue;
+    const auto s = hinge_slots(i);
+    out.theta[i] = dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
+    delta[i] = wrap_angle(out.theta[i] - rest_theta[i]);
+    grad[i] = dihedral_angle_gradient(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
+  }
+  const Vec3 Qd = Q * delta;
+  out.energy = delta.dot(Qd);
+  for (int i = 0; i < 3; ++i) {
+    if (!has_wing[i]) continue;
+    const auto s = hinge_slots(i);
+    for (int a = 0; a < 4; ++a) out.gradient.segment<3>(3 * s[a]) += 2 * Qd[i] * grad[i].segment<3>(3 * a);
+  }
+  if (hessian == HessianKind::kNone) return out;
+
+  // Gauss-Newton part 2 sum_ij Q_ij grad_i grad_j^T, scattered to element slots.
+  for (int i = 0; i < 3; ++i) {
+    if (!has_wing[i]) continue;
+    const auto si = hinge_slots(i);
+    for (int j = 0; j < 3; ++j) {
+      if (!has_wing[j] || Q(i, j) == 0) continue;
+      const auto sj = hinge_slots(j);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          out.hessian.block<3, 3>(3 * si[a], 3 * sj[b]) +=
+              2 * Q(i, j) * grad[i].segment<3>(3 * a) * grad[j].segment<3>(3 * b).transpose();
+    }
+  }
+  if (hessian == HessianKind::kExact) {
+    // Curvature part 2 sum_i (Q d)_i d2(theta_i).
+    for (int i = 0; i < 3; ++i) {
+      if (!has_wing[i] || Qd[i] == 0) continue;
+      const auto s = hinge_slots(i);
+      const Mat12 H = dihedral_angle_hessian(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          out.hessian.block<3, 3>(3 * s[a], 3 * s[b]) += 2 * Qd[i] * H.block<3, 3>(3 * a, 3 * b);
+    }
+  }
+  return out;
+}
+
+}  // namespace arcsim

@@ -1,0 +1,22 @@
+// Aerodynamic force on one face (ARCSim's wind model): with v the wind velocity minus the face's mean node
+// velocity, n the world unit normal, v_n = v . n (m/s) and v_t = v - v_n n,
+//   face force (N) = density * A_w * |v_n| v_n n + drag * A_w * v_t,
+// A_w the world area (m^2). The force is distributed 1/3 per node. `density` is the air density (kg/m^3),
+// `drag` the tangential drag coefficient (kg/(m^2 s)). A face with zero world area gets no force.
+#pragma once
+
+#include "math/types.hpp"
+
+namespace arcsim {
+
+struct WindForce {
+  Vec9 force = Vec9::Zero();     // nodal forces (N), stacked per node
+  Mat9 jacobian = Mat9::Zero();  // d force / d (v0, v1, v2) (kg/s); symmetric negative semi-definite
+};
+
+// Force on the face (x0, x1, x2) (m) with node velocities v0, v1, v2 (m/s). The Jacobian is with respect to
+// the node velocities at fixed positions, so the implicit solver can treat drag implicitly.
+WindForce wind_force(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& v0, const Vec3& v1,
+                     const Vec3& v2, const Vec3& wind_velocity, double density, double drag);
+
+}  // namespace arcsim

@@ -1,0 +1,416 @@
+#include "render/render.hpp"
+
+#define GL_GLEXT_PROTOTYPES
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "io/errors.hpp"
+
+namespace arcsim {
+
+namespace {
+
+// Look of the image. Colours are linear 0..1 RGB(A) as OpenGL takes them.
+constexpr GLfloat kBackgroundTop[3] = {0.98f, 0.985f, 0.99f};
+constexpr GLfloat kBackgroundBottom[3] = {0.80f, 0.82f, 0.85f};
+constexpr GLfloat kGroundLight[3] = {0.92f, 0.925f, 0.93f};
+constexpr GLfloat kGroundDark[3] = {0.87f, 0.875f, 0.88f};
+constexpr GLfloat kShadow[4] = {0.0f, 0.0f, 0.02f, 0.30f};
+constexpr GLfloat kClothFront[4] = {0.97f, 0.62f, 0.34f, 1.0f};
+constexpr GLfloat kClothBack[4] = {0.46f, 0.55f, 0.70f, 1.0f};
+constexpr GLfloat kObstacle[4] = {0.66f, 0.66f, 0.66f, 1.0f};
+constexpr GLfloat kHighlight[4] = {0.16f, 0.09f, 0.05f, 1.0f};
+constexpr GLfloat kWire[4] = {0.12f, 0.06f, 0.02f, 0.35f};
+
+constexpr int kMaxImageSide = 16384;
+
+// One mesh in the form glDrawElements wants, built once per frame and reused by every pass.
+struct MeshArrays {
+  std::vector<GLfloat> positions, normals;  // 3 per vertex
+  std::vector<GLuint> triangles, highlight, wire;
+  bool casts_shadow = true;
+};
+
+// Per-vertex normals: the sum of the adjacent faces' cross products, i.e. area-weighted face normals, so that
+// slivers from remeshing do not bias the shading.
+MeshArrays prepare(const RenderMesh& mesh, bool wireframe, bool highlight, const Stage& stage) {
+  MeshArrays a;
+  const size_t n = mesh.positions.size();
+  std::vector<Vec3> normal_sum(n, Vec3::Zero());
+  a.triangles.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    const Vec3 face = (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
+    for (int v : t) {
+      normal_sum[v] += face;
+      a.triangles.push_back(GLuint(v));
+    }
+  }
+  a.positions.resize(3 * n);
+  a.normals.resize(3 * n);
+  double highest = -kInfinity;
+  for (size_t i = 0; i < n; ++i) {
+    const double len = normal_sum[i].norm();
+    const Vec3 unit = len > 0 ? Vec3(normal_sum[i] / len) : stage.up;
+    for (int k = 0; k < 3; ++k) {
+      a.positions[3 * i + k] = GLfloat(mesh.positions[i][k]);
+      a.normals[3 * i + k] = GLfloat(unit[k]);
+    }
+    highest = std::max(highest, stage.up.dot(mesh.positions[i]));
+  }
+  // A floor lying on the ground would project its shadow onto itself and darken all of it.
+  a.casts_shadow = highest - stage.ground_level > 1e-3 * stage.scene_radius;
+  if (highlight)
+    for (const auto& e : mesh.highlight_edges) a.highlight.insert(a.highlight.end(), {GLuint(e[0]), GLuint(e[1])});
+  if (wireframe)
+    for (const auto& e : unique_edges(mesh.triangles)) a.wire.insert(a.wire.end(), {GLuint(e[0]), GLuint(e[1])});
+  return a;
+}
+
+void set_vertex_arrays(const MeshArrays& a, bool with_normals) {
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glVertexPointer(3, GL_FLOAT, 0, a.positions.data());
+  if (with_normals) {
+    glEnableClientState(GL_NORMAL_ARRAY);
+    glNormalPointer(GL_FLOAT, 0, a.normals.data());
+  } else {
+    glDisableClientState(GL_NORMAL_ARRAY);
+  }
+}
+
+void draw_triangles(const MeshArrays& a, bool with_normals) {
+  if (a.triangles.empty()) return;
+  set_vertex_arrays(a, with_normals);
+  glDrawElements(GL_TRIANGLES, GLsizei(a.triangles.size()), GL_UNSIGNED_INT, a.triangles.data());
+}
+
+void draw_lines(const MeshArrays& a, const std::vector<GLuint>& lines) {
+  if (lines.empty()) return;
+  set_vertex_arrays(a, false);
+  glDrawElements(GL_LINES, GLsizei(lines.size()), GL_UNSIGNED_INT, lines.data());
+}
+
+void set_material(GLenum face, const GLfloat colour[4], GLfloat specular, GLfloat shininess) {
+  const GLfloat spec[4] = {specular, specular, specular, 1};
+  glMaterialfv(face, GL_AMBIENT_AND_DIFFUSE, colour);
+  glMaterialfv(face, GL_SPECULAR, spec);
+  glMaterialf(face, GL_SHININESS, shininess);
+}
+
+void set_light(GLenum light, const Vec3& toward, GLfloat diffuse, GLfloat specular) {
+  const GLfloat position[4] = {GLfloat(toward.x()), GLfloat(toward.y()), GLfloat(toward.z()), 0};  // directional
+  const GLfloat zero[4] = {0, 0, 0, 1};
+  const GLfloat dif[4] = {diffuse, diffuse, diffuse, 1};
+  const GLfloat spec[4] = {specular, specular, specular, 1};
+  glEnable(light);
+  glLightfv(light, GL_POSITION, position);  // transformed by the current (view) matrix: world direction
+  glLightfv(light, GL_AMBIENT, zero);
+  glLightfv(light, GL_DIFFUSE, dif);
+  glLightfv(light, GL_SPECULAR, spec);
+}
+
+void draw_background() {
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_LIGHTING);
+  glBegin(GL_QUADS);
+  glColor3fv(kBackgroundBottom);
+  glVertex2f(-1, -1);
+  glVertex2f(1, -1);
+  glColor3fv(kBackgroundTop);
+  glVertex2f(1, 1);
+  glVertex2f(-1, 1);
+  glEnd();
+}
+
+double smoothstep(double edge0, double edge1, double x) {
+  const double t = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
+  return t * t * (3 - 2 * t);
+}
+
+// Checkered square around the scene, aligned with world units, fading into the background towards its border.
+void draw_ground(const Stage& stage) {
+  const HorizontalAxes axes = horizontal_axes(stage.up);
+  double cell = checker_cell_size(stage.scene_radius);
+  const double radius = stage.ground_radius;
+  while (2 * radius / cell > 200) cell *= 2;  // bounded work whatever the scene size
+  // Slightly below the lowest point, so sheets resting there do not fight with the ground for depth.
+  const Vec3 origin = stage.up * (stage.ground_level - 2e-3 * stage.scene_radius);
+  const double ca = stage.ground_center.dot(axes.side), cb = stage.ground_center.dot(axes.front);
+  const long i0 = long(std::floor((ca - radius) / cell)), i1 = long(std::ceil((ca + radius) / cell));
+  const long j0 = long(std::floor((cb - radius) / cell)), j1 = long(std::ceil((cb + radius) / cell));
+  glBegin(GL_QUADS);
+  for (long i = i0; i < i1; ++i)
+    for (long j = j0; j < j1; ++j) {
+      const GLfloat* c = ((i + j) & 1) ? kGroundDark : kGroundLight;
+      // Alpha carries the fade, which differs per corner.
+      auto corner = [&](long ii, long jj) {
+        const double a = double(ii) * cell, b = double(jj) * cell;
+        const double fade = 1 - smoothstep(0.35 * radius, radius, std::hypot(a - ca, b - cb));
+        glColor4f(c[0], c[1], c[2], GLfloat(fade));
+        const Vec3 p = origin + a * axes.side + b * axes.front;
+        glVertex3d(p.x(), p.y(), p.z());
+      };
+      corner(i, j);
+      corner(i + 1, j);
+      corner(i + 1, j + 1);
+      corner(i, j + 1);
+    }
+  glEnd();
+}
+
+std::string gl_error_text(GLenum error) {
+  char text[32];
+  std::snprintf(text, sizeof text, "0x%04x", unsigned(error));
+  return text;
+}
+
+}  // namespace
+
+struct Renderer::Context {
+  OSMesaContext osmesa = nullptr;
+  std::vector<uint8_t> buffer;  // OSMesa's colour buffer: RGBA rows bottom-up
+  // Multisampled off-screen target, resolved into `buffer` at the end of a frame.
+  GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
+  int fbo_samples = 0;          // samples of the current target (0: none, draw straight into `buffer`)
+  int width = 0, height = 0;
+
+  ~Context() {
+    if (!osmesa) return;
+    if (fbo && OSMesaMakeCurrent(osmesa, buffer.data(), GL_UNSIGNED_BYTE, width, height)) release_target();
+    OSMesaDestroyContext(osmesa);
+  }
+
+  void make_current() {
+    if (!OSMesaMakeCurrent(osmesa, buffer.data(), GL_UNSIGNED_BYTE, width, height))
+      throw std::runtime_error("OSMesa: cannot bind the off-screen context to a " + std::to_string(width) + "x" +
+                               std::to_string(height) + " RGBA buffer");
+  }
+
+  void release_target() {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (colour_rb) glDeleteRenderbuffers(1, &colour_rb);
+    if (depth_rb) glDeleteRenderbuffers(1, &depth_rb);
+    fbo = colour_rb = depth_rb = 0;
+    fbo_samples = 0;
+  }
+
+  // Binds a target with (up to) `samples` samples per pixel; falls back to the plain buffer if the
+  // implementation cannot multisample.
+  void bind_target(int samples) {
+    GLint max_samples = 0;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    const int wanted = std::min(samples, int(max_samples));
+    if (wanted <= 1) {
+      if (fbo) release_target();
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      return;
+    }
+    if (fbo && fbo_samples == wanted) {
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+      return;
+    }
+    release_target();
+    glGenFramebuffers(1, &fbo);
+    glGenRenderbuffers(1, &colour_rb);
+    glGenRenderbuffers(1, &depth_rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, colour_rb);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, wanted, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, wanted, GL_DEPTH24_STENCIL8, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_rb);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+    fbo_samples = wanted;
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      release_target();
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+    while (glGetError() != GL_NO_ERROR) {
+    }
+  }
+
+  // Copies the multisampled image (if any) into `buffer` and waits until it is there.
+  void finish() {
+    if (fbo) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+      glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+    glFinish();
+  }
+};
+
+Renderer::Renderer(int width, int height) : context_(std::make_unique<Context>()), width_(width), height_(height) {
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+    throw std::runtime_error("renderer: image size " + std::to_string(width) + "x" + std::to_string(height) +
+                             " is outside 1.." + std::to_string(kMaxImageSide));
+  context_->width = width;
+  context_->height = height;
+  context_->buffer.assign(size_t(width) * size_t(height) * 4, 0);
+  context_->osmesa = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+  if (!context_->osmesa)
+    throw std::runtime_error("OSMesa: cannot create an off-screen RGBA context with 24-bit depth and 8-bit stencil");
+  context_->make_current();
+  rgba_.assign(context_->buffer.size(), 0);
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::render(const std::vector<RenderMesh>& cloths, const std::vector<RenderMesh>& obstacles,
+                      const Camera& camera, const RenderOptions& options) {
+  for (size_t i = 0; i < cloths.size(); ++i) check_render_mesh(cloths[i], "render: cloth " + std::to_string(i));
+  for (size_t i = 0; i < obstacles.size(); ++i)
+    check_render_mesh(obstacles[i], "render: obstacle " + std::to_string(i));
+
+  Eigen::AlignedBox3d box = bounds_of(cloths).extend(bounds_of(obstacles));
+  if (!options.scene_bounds.isEmpty() && options.scene_bounds.min().allFinite() &&
+      options.scene_bounds.max().allFinite())
+    box.extend(options.scene_bounds);
+  const Eigen::AlignedBox3d level_box = options.scene_bounds.isEmpty() ? box : options.scene_bounds;
+  const double level = options.ground_level && std::isfinite(*options.ground_level)
+                           ? *options.ground_level
+                           : (level_box.isEmpty() ? kInfinity : lowest_level(level_box, options.up.normalized()));
+  const Stage stage = make_stage(camera, options.up, box, level);
+
+  std::vector<MeshArrays> cloth_arrays, obstacle_arrays;
+  for (const RenderMesh& m : cloths) cloth_arrays.push_back(prepare(m, options.wireframe, options.highlight_edges, stage));
+  for (const RenderMesh& m : obstacles) obstacle_arrays.push_back(prepare(m, false, false, stage));
+
+  Context& ctx = *context_;
+  ctx.make_current();
+  ctx.bind_target(options.samples);
+  glViewport(0, 0, width_, height_);
+  glDisable(GL_SCISSOR_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glStencilMask(0xff);
+  glClearColor(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2], 1);
+  glClearDepth(1);
+  glClearStencil(0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  if (ctx.fbo) glEnable(GL_MULTISAMPLE);
+  glShadeModel(GL_SMOOTH);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_STENCIL_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  draw_background();
+
+  // Clipping planes just around everything that can be drawn (the ground reaches beyond the scene).
+  const double reach = std::max(stage.scene_radius, options.ground ? std::sqrt(2.0) * stage.ground_radius : 0.0);
+  const double distance = (camera.eye - box.center()).norm();
+  const double z_far = std::max(distance + 1.05 * reach, 1e-6);
+  const double z_near = std::max(z_far * 1e-3, distance - 1.05 * reach);
+  const Mat4 projection = projection_matrix(camera, double(width_) / double(height_), z_near, z_far);
+  const Mat4 view = view_matrix(camera);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixd(projection.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadMatrixd(view.data());
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+
+  // Ground and obstacles mark the stencil buffer: shadows are drawn only there, once per pixel.
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  if (options.ground) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glPolygonOffset(4, 16);
+    draw_ground(stage);
+    glDisable(GL_BLEND);
+  }
+
+  const GLfloat ambient[4] = {0.30f, 0.30f, 0.30f, 1};
+  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+  glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
+  set_light(GL_LIGHT0, stage.key_light, 0.72f, 0.25f);
+  set_light(GL_LIGHT1, stage.fill_light, 0.30f, 0.0f);
+  glColor4f(1, 1, 1, 1);
+
+  glEnable(GL_LIGHTING);
+  set_material(GL_FRONT_AND_BACK, kObstacle, 0.12f, 20);
+  glPolygonOffset(2, 4);
+  for (const MeshArrays& a : obstacle_arrays) draw_triangles(a, true);
+  glDisable(GL_LIGHTING);
+
+  if (options.ground && options.shadows) {
+    glStencilFunc(GL_EQUAL, 1, 0xff);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glColor4fv(kShadow);
+    glPolygonOffset(-1, -4);
+    const Mat4 shadow = view * planar_shadow_matrix(stage.up, stage.ground_level, stage.key_light);
+    glLoadMatrixd(shadow.data());
+    for (const auto* list : {&obstacle_arrays, &cloth_arrays})
+      for (const MeshArrays& a : *list)
+        if (a.casts_shadow) draw_triangles(a, false);
+    glLoadMatrixd(view.data());
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+  }
+  glDisable(GL_STENCIL_TEST);
+
+  glEnable(GL_LIGHTING);
+  set_material(GL_FRONT, kClothFront, 0.15f, 28);
+  set_material(GL_BACK, kClothBack, 0.10f, 28);
+  glPolygonOffset(1, 1);
+  for (const MeshArrays& a : cloth_arrays) draw_triangles(a, true);
+  glDisable(GL_LIGHTING);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+
+  // Lines sit exactly on the surfaces, which were pushed back by the polygon offset, so they win the depth test.
+  const GLfloat line_scale = GLfloat(std::max(1.0, height_ / 720.0));
+  if (options.wireframe) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    glLineWidth(line_scale);
+    glColor4fv(kWire);
+    for (const MeshArrays& a : cloth_arrays) draw_lines(a, a.wire);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+  }
+  if (options.highlight_edges) {
+    glLineWidth(2 * line_scale);
+    glColor4fv(kHighlight);
+    for (const MeshArrays& a : cloth_arrays) draw_lines(a, a.highlight);
+  }
+  glDisableClientState(GL_VERTEX_ARRAY);
+  glDisableClientState(GL_NORMAL_ARRAY);
+
+  ctx.finish();
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) throw std::runtime_error("renderer: OpenGL error " + gl_error_text(error));
+
+  const size_t row = size_t(width_) * 4;
+  for (int y = 0; y < height_; ++y)
+    std::memcpy(&rgba_[size_t(y) * row], &ctx.buffer[size_t(height_ - 1 - y) * row], row);
+  for (size_t i = 3; i < rgba_.size(); i += 4) rgba_[i] = 255;
+}
+
+void render_frame_png(Renderer& renderer, const std::vector<RenderMesh>& cloths,
+                      const std::vector<RenderMesh>& obstacles, const Camera& camera, const RenderOptions& options,
+                      const std::string& png_path) {
+  renderer.render(cloths, obstacles, camera, options);
+  write_png(png_path, renderer.width(), renderer.height(), renderer.rgba());
+}
+
+}  // namespace arcsim
