@@ -7,11 +7,13 @@ PKGS     := eigen3 nlopt jsoncpp libpng osmesa
 DEPS_OK  := $(shell pkg-config --exists $(PKGS) 2>/dev/null && test -f /usr/include/suitesparse/cholmod.h && echo yes)
 
 # CHOLMOD (SuiteSparse 5 on Debian 12) ships no pkg-config file.
-CHOLMOD_CFLAGS := -I/usr/include/suitesparse
+CHOLMOD_CFLAGS := -isystem /usr/include/suitesparse
 CHOLMOD_LIBS   := -lcholmod -lamd -lcolamd -lsuitesparseconfig
 
 WARN     := -Wall -Wextra -Wshadow=local -Wno-unused-parameter
-BASEFLAGS := -std=c++17 $(WARN) -fopenmp -Isrc $(CHOLMOD_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+# Dependency headers are system headers: their own warnings (Eigen's false maybe-uninitialized) are not ours.
+BASEFLAGS := -std=c++17 $(WARN) -fopenmp -Isrc $(CHOLMOD_CFLAGS) \
+             $(patsubst -I%,-isystem %,$(shell pkg-config --cflags $(PKGS) 2>/dev/null))
 LIBS     := $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(CHOLMOD_LIBS) -fopenmp -lpthread
 
 RELEASE_FLAGS := -O2 -DNDEBUG -DEIGEN_NO_DEBUG
@@ -20,6 +22,7 @@ ASAN_FLAGS    := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fn
 LIB_SRC   := $(shell find src -name '*.cpp' ! -path 'src/app/main.cpp' | sort)
 MAIN_SRC  := src/app/main.cpp
 TEST_SRC  := $(shell find tests -name '*.cpp' 2>/dev/null | sort)
+TEST_FLAGS := -Itests
 BENCH_SRC := $(shell find tools/bench -name '*.cpp' 2>/dev/null | sort)
 
 obj = $(patsubst %.cpp,build/$(1)/%.o,$(2))
@@ -44,6 +47,19 @@ build/release/%.o: %.cpp
 build/asan/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(BASEFLAGS) $(ASAN_FLAGS) -MMD -MP -c $< -o $@
+
+# Tests and benchmarks may also include test support headers (tests/support/).
+build/release/tests/%.o: tests/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(BASEFLAGS) $(TEST_FLAGS) $(RELEASE_FLAGS) -MMD -MP -c $< -o $@
+
+build/asan/tests/%.o: tests/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(BASEFLAGS) $(TEST_FLAGS) $(ASAN_FLAGS) -MMD -MP -c $< -o $@
+
+build/release/tools/%.o: tools/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(BASEFLAGS) $(TEST_FLAGS) $(RELEASE_FLAGS) -MMD -MP -c $< -o $@
 
 bin/arcsim: $(call obj,release,$(LIB_SRC) $(MAIN_SRC))
 	@mkdir -p bin

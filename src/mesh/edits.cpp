@@ -35,12 +35,19 @@ std::vector<int> neighbours(const Mesh& m, int n) {
   return result;
 }
 
+// A new face may turn its rest normal by at most this angle from the face(s) it replaces (cos 60 deg). Beyond
+// it the rest surface folds: on flat sheets that is an inversion, on curved ones a face standing across the
+// surface (a flip of three nearly collinear points on a curved edge path would create one).
+constexpr double kMinNormalCosine = 0.5;
+
 // Rest-space triangle check for a face about to be created: not degenerate and, if a reference normal is given,
-// on the same side as it (not inverted).
+// not turned away from it (see kMinNormalCosine).
 bool rest_triangle_ok(const Mesh& m, const std::array<int, 3>& v, const Vec3* reference_normal = nullptr) {
   const Vec3 &u0 = m.verts[v[0]].u, &u1 = m.verts[v[1]].u, &u2 = m.verts[v[2]].u;
   if (rest_triangle_degenerate(u0, u1, u2)) return false;
-  return reference_normal == nullptr || (u1 - u0).cross(u2 - u0).dot(*reference_normal) > 0;
+  if (reference_normal == nullptr) return true;
+  const Vec3 normal = (u1 - u0).cross(u2 - u0);
+  return normal.dot(*reference_normal) > kMinNormalCosine * normal.norm() * reference_normal->norm();
 }
 
 // Unnormalised rest normal (twice the area) of an existing face, computed from the verts.
@@ -549,14 +556,15 @@ EditResult split_node(Mesh& m, int node, const std::vector<int>& cut_edges) {
     m.remove_face(f);
     r.removed_faces.push_back(f);
   }
-  for (const NodeSplitPlan& plan : plans) {
-    remove_faceless_edges(m, std::vector<int>(m.nodes[plan.node].edges), r);
-    remove_faceless_verts(m, plan.node, r);
-  }
   const size_t first_edge = m.edges.size();
   size_t i = 0;
   for (const auto& [f, v] : new_corners) r.added_faces.push_back(m.add_face(v, protos[i++]));
   append_range(r.added_edges, first_edge, m.edges.size());
+  // Orphans only now: a face that keeps a split node's old vert (it moved for the other node) is back.
+  for (const NodeSplitPlan& plan : plans) {
+    remove_faceless_edges(m, std::vector<int>(m.nodes[plan.node].edges), r);
+    remove_faceless_verts(m, plan.node, r);
+  }
   for (int f : r.added_faces) m.update_rest_data(f);
 
   auto original = [&](int n) {

@@ -33,7 +33,8 @@ EditResult split_edge(Mesh& mesh, int edge, double t);
 
 // Replaces the diagonal of the two faces of `edge` by the other diagonal. Only for an interior, non-seam,
 // non-preserved edge between faces of one material; refused if the other diagonal already exists or a new face
-// would be degenerate or inverted in rest space. New faces get the area-weighted average thickness, Fp, Sp,
+// would be degenerate or inverted in rest space (its rest normal turned by more than 60 degrees from either old
+// face: an inversion on a flat sheet, a face standing across a curved one). New faces get the area-weighted average thickness, Fp, Sp,
 // damage; the new edge rest_theta = rest dihedral. The four outer edges keep their plastic offset
 // (rest_theta minus rest dihedral) while their rest dihedral follows the new faces.
 EditResult flip_edge(Mesh& mesh, int edge);
@@ -43,8 +44,8 @@ EditResult flip_edge(Mesh& mesh, int edge);
 // the boundary but the edge is not, the link condition fails (common neighbours other than the edge's
 // opposite nodes), a duplicate face would appear, a node would be left without faces, the removed node's rest
 // verts cannot be mapped onto the kept node's (a seam through the removed node not along the edge), or a
-// surviving face would become degenerate or inverted in rest space. Surviving faces keep their state; edges
-// whose wings change keep their plastic offset (see flip_edge).
+// surviving face would become degenerate or inverted in rest space (normal turned by more than 60 degrees).
+// Surviving faces keep their state; edges whose wings change keep their plastic offset (see flip_edge).
 EditResult collapse_edge(Mesh& mesh, int edge, int remove_side);
 
 // Vertex split for a crack at `node` along 1 or 2 interior `cut_edges` incident to it. The faces around the

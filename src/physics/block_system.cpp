@@ -100,6 +100,17 @@ void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
 CholeskySolver::CholeskySolver() = default;
 CholeskySolver::~CholeskySolver() = default;
 
+CholeskySolver::CholeskySolver(CholeskySolver&& other) noexcept { *this = std::move(other); }
+
+CholeskySolver& CholeskySolver::operator=(CholeskySolver&& other) noexcept {
+  llt_ = std::move(other.llt_);
+  matrix_.swap(other.matrix_);
+  analysed_pattern_ = other.analysed_pattern_;
+  analyses_ = other.analyses_;
+  other.analysed_pattern_ = 0;
+  return *this;
+}
+
 bool CholeskySolver::factorize(const BlockSystem& system) {
   const uint64_t id = system.pattern->id();
   if (!llt_ || analysed_pattern_ != id) {

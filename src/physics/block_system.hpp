@@ -94,6 +94,8 @@ class CholeskySolver {
  public:
   CholeskySolver();
   ~CholeskySolver();
+  CholeskySolver(CholeskySolver&& other) noexcept;
+  CholeskySolver& operator=(CholeskySolver&& other) noexcept;
   // Factorises the system's matrix. Returns false if it is not positive definite or the factorisation failed.
   bool factorize(const BlockSystem& system);
   // Solves with the last factorisation.

@@ -73,7 +73,10 @@ Mat2 stress_from_voigt(const Vec3& s) {
 
 // A [ J^T K J + (shape S shape^T) (x) I3 ].
 Mat9 hessian_from(const Kinematics& kin, const Mat3& K, const Mat2& S, double rest_area) {
-  Mat9 H = kin.J.transpose() * K * kin.J;
+  // lazyProduct: a coefficient-wise product; Eigen would otherwise route this 9x3x9 product to its
+  // general (blocked, OpenMP-aware) matrix-matrix kernel, which is slower at this size.
+  const Eigen::Matrix<double, 9, 3> JtK = kin.J.transpose() * K;
+  Mat9 H = JtK.lazyProduct(kin.J);
   const Mat3 geometric = kin.shape * S * kin.shape.transpose();
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) H.block<3, 3>(3 * a, 3 * b).diagonal().array() += geometric(a, b);

@@ -137,7 +137,8 @@ Camera frame_camera(const Eigen::AlignedBox3d& bounds, double aspect, const Vec3
       image.extend(Vec2(q.dot(frame.right) / (depth * tan_x), q.dot(frame.up) / (depth * tan_y)));
     }
     const double target_depth = (camera.target - eye).norm();
-    camera.target += target_depth * (image.center().x() * tan_x * frame.right + image.center().y() * tan_y * frame.up);
+    camera.target +=
+        target_depth * (image.center().x() * tan_x * frame.right + image.center().y() * tan_y * frame.up);
   }
   const double distance = fitted_distance(camera.target);
   camera.eye = camera.target + distance * frame.back;

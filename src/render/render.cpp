@@ -1,17 +1,16 @@
 #include "render/render.hpp"
 
-#define GL_GLEXT_PROTOTYPES
-#include <GL/osmesa.h>
 #include <GL/gl.h>
-#include <GL/glext.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <stdexcept>
 
 #include "io/errors.hpp"
+#include "render/offscreen.hpp"
 
 namespace arcsim {
 
@@ -25,11 +24,9 @@ constexpr GLfloat kGroundDark[3] = {0.87f, 0.875f, 0.88f};
 constexpr GLfloat kShadow[4] = {0.0f, 0.0f, 0.02f, 0.30f};
 constexpr GLfloat kClothFront[4] = {0.97f, 0.62f, 0.34f, 1.0f};
 constexpr GLfloat kClothBack[4] = {0.46f, 0.55f, 0.70f, 1.0f};
-constexpr GLfloat kObstacle[4] = {0.66f, 0.66f, 0.66f, 1.0f};
+constexpr GLfloat kObstacle[4] = {0.72f, 0.72f, 0.72f, 1.0f};
 constexpr GLfloat kHighlight[4] = {0.16f, 0.09f, 0.05f, 1.0f};
 constexpr GLfloat kWire[4] = {0.12f, 0.06f, 0.02f, 0.35f};
-
-constexpr int kMaxImageSide = 16384;
 
 // One mesh in the form glDrawElements wants, built once per frame and reused by every pass.
 struct MeshArrays {
@@ -46,7 +43,8 @@ MeshArrays prepare(const RenderMesh& mesh, bool wireframe, bool highlight, const
   std::vector<Vec3> normal_sum(n, Vec3::Zero());
   a.triangles.reserve(3 * mesh.triangles.size());
   for (const auto& t : mesh.triangles) {
-    const Vec3 face = (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
+    const Vec3& p0 = mesh.positions[t[0]];
+    const Vec3 face = (mesh.positions[t[1]] - p0).cross(mesh.positions[t[2]] - p0);
     for (int v : t) {
       normal_sum[v] += face;
       a.triangles.push_back(GLuint(v));
@@ -168,6 +166,102 @@ void draw_ground(const Stage& stage) {
   glEnd();
 }
 
+// Resets the state a previous frame may have left and paints the background gradient.
+void clear_to_background(int width, int height, bool multisampled) {
+  glViewport(0, 0, width, height);
+  glDisable(GL_SCISSOR_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glStencilMask(0xff);
+  glClearColor(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2], 1);
+  glClearDepth(1);
+  glClearStencil(0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  if (multisampled) glEnable(GL_MULTISAMPLE);
+  glShadeModel(GL_SMOOTH);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_STENCIL_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  draw_background();
+}
+
+// Loads the camera's projection and view (returned) and enables depth testing. The clipping planes hug
+// everything that can be drawn (the ground reaches beyond the scene), for depth precision.
+Mat4 load_camera(const Camera& camera, const Stage& stage, const Eigen::AlignedBox3d& box, bool ground,
+                 double aspect) {
+  const double reach = std::max(stage.scene_radius, ground ? std::sqrt(2.0) * stage.ground_radius : 0.0);
+  const double distance = (camera.eye - box.center()).norm();
+  const double z_far = std::max(distance + 1.05 * reach, 1e-6);
+  const double z_near = std::max(z_far * 1e-3, distance - 1.05 * reach);
+  const Mat4 projection = projection_matrix(camera, aspect, z_near, z_far);
+  const Mat4 view = view_matrix(camera);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixd(projection.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadMatrixd(view.data());
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  return view;
+}
+
+// Two-sided lighting: back faces are lit with the reversed normal and the back material. Needs the view matrix
+// loaded (light directions are given in world space).
+void set_lights(const Stage& stage) {
+  const GLfloat ambient[4] = {0.30f, 0.30f, 0.30f, 1};
+  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+  glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
+  set_light(GL_LIGHT0, stage.key_light, 0.72f, 0.25f);
+  set_light(GL_LIGHT1, stage.fill_light, 0.30f, 0.0f);
+  glColor4f(1, 1, 1, 1);
+}
+
+// Darkens the ground and obstacle pixels (stencil 1) covered by the meshes flattened onto the ground along the
+// key light; each pixel once (stencil becomes 2). Pulled forward so it wins against a floor obstacle lying in the
+// ground plane, while anything standing in front of the plane still hides it.
+void draw_shadows(const Stage& stage, const Mat4& view,
+                  std::initializer_list<const std::vector<MeshArrays>*> casters) {
+  glStencilFunc(GL_EQUAL, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glColor4fv(kShadow);
+  glPolygonOffset(-1, -4);
+  const Mat4 shadow = view * planar_shadow_matrix(stage.up, stage.ground_level, stage.key_light);
+  glLoadMatrixd(shadow.data());
+  for (const auto* list : casters)
+    for (const MeshArrays& a : *list)
+      if (a.casts_shadow) draw_triangles(a, false);
+  glLoadMatrixd(view.data());
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+}
+
+// Wireframe and highlighted edges of the cloths. Lines sit exactly on the surfaces, which were pushed back by
+// the polygon offset, so they win the depth test where the surface is visible.
+void draw_edges(const std::vector<MeshArrays>& cloths, const RenderOptions& options, int image_height) {
+  const GLfloat line_scale = GLfloat(std::max(1.0, image_height / 720.0));
+  if (options.wireframe) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    glLineWidth(line_scale);
+    glColor4fv(kWire);
+    for (const MeshArrays& a : cloths) draw_lines(a, a.wire);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+  }
+  if (options.highlight_edges) {
+    glLineWidth(2 * line_scale);
+    glColor4fv(kHighlight);
+    for (const MeshArrays& a : cloths) draw_lines(a, a.highlight);
+  }
+  glDisableClientState(GL_VERTEX_ARRAY);
+  glDisableClientState(GL_NORMAL_ARRAY);
+}
+
 std::string gl_error_text(GLenum error) {
   char text[32];
   std::snprintf(text, sizeof text, "0x%04x", unsigned(error));
@@ -176,94 +270,9 @@ std::string gl_error_text(GLenum error) {
 
 }  // namespace
 
-struct Renderer::Context {
-  OSMesaContext osmesa = nullptr;
-  std::vector<uint8_t> buffer;  // OSMesa's colour buffer: RGBA rows bottom-up
-  // Multisampled off-screen target, resolved into `buffer` at the end of a frame.
-  GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
-  int fbo_samples = 0;          // samples of the current target (0: none, draw straight into `buffer`)
-  int width = 0, height = 0;
-
-  ~Context() {
-    if (!osmesa) return;
-    if (fbo && OSMesaMakeCurrent(osmesa, buffer.data(), GL_UNSIGNED_BYTE, width, height)) release_target();
-    OSMesaDestroyContext(osmesa);
-  }
-
-  void make_current() {
-    if (!OSMesaMakeCurrent(osmesa, buffer.data(), GL_UNSIGNED_BYTE, width, height))
-      throw std::runtime_error("OSMesa: cannot bind the off-screen context to a " + std::to_string(width) + "x" +
-                               std::to_string(height) + " RGBA buffer");
-  }
-
-  void release_target() {
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (fbo) glDeleteFramebuffers(1, &fbo);
-    if (colour_rb) glDeleteRenderbuffers(1, &colour_rb);
-    if (depth_rb) glDeleteRenderbuffers(1, &depth_rb);
-    fbo = colour_rb = depth_rb = 0;
-    fbo_samples = 0;
-  }
-
-  // Binds a target with (up to) `samples` samples per pixel; falls back to the plain buffer if the
-  // implementation cannot multisample.
-  void bind_target(int samples) {
-    GLint max_samples = 0;
-    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-    const int wanted = std::min(samples, int(max_samples));
-    if (wanted <= 1) {
-      if (fbo) release_target();
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      return;
-    }
-    if (fbo && fbo_samples == wanted) {
-      glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-      return;
-    }
-    release_target();
-    glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(1, &colour_rb);
-    glGenRenderbuffers(1, &depth_rb);
-    glBindRenderbuffer(GL_RENDERBUFFER, colour_rb);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, wanted, GL_RGBA8, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, wanted, GL_DEPTH24_STENCIL8, width, height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_rb);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
-    fbo_samples = wanted;
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      release_target();
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    }
-    while (glGetError() != GL_NO_ERROR) {
-    }
-  }
-
-  // Copies the multisampled image (if any) into `buffer` and waits until it is there.
-  void finish() {
-    if (fbo) {
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-      glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    }
-    glFinish();
-  }
-};
-
-Renderer::Renderer(int width, int height) : context_(std::make_unique<Context>()), width_(width), height_(height) {
-  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
-    throw std::runtime_error("renderer: image size " + std::to_string(width) + "x" + std::to_string(height) +
-                             " is outside 1.." + std::to_string(kMaxImageSide));
-  context_->width = width;
-  context_->height = height;
-  context_->buffer.assign(size_t(width) * size_t(height) * 4, 0);
-  context_->osmesa = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
-  if (!context_->osmesa)
-    throw std::runtime_error("OSMesa: cannot create an off-screen RGBA context with 24-bit depth and 8-bit stencil");
-  context_->make_current();
-  rgba_.assign(context_->buffer.size(), 0);
+Renderer::Renderer(int width, int height)
+    : context_(std::make_unique<OffscreenContext>(width, height)), width_(width), height_(height) {
+  rgba_.assign(size_t(width) * size_t(height) * 4, 0);
 }
 
 Renderer::~Renderer() = default;
@@ -278,49 +287,23 @@ void Renderer::render(const std::vector<RenderMesh>& cloths, const std::vector<R
   if (!options.scene_bounds.isEmpty() && options.scene_bounds.min().allFinite() &&
       options.scene_bounds.max().allFinite())
     box.extend(options.scene_bounds);
+  // The ground stays where the whole animation's lowest point is, even when this frame's meshes are higher.
+  const Vec3 up = up_from_gravity(-options.up);  // unit, with a fallback for a zero vector
   const Eigen::AlignedBox3d level_box = options.scene_bounds.isEmpty() ? box : options.scene_bounds;
   const double level = options.ground_level && std::isfinite(*options.ground_level)
                            ? *options.ground_level
-                           : (level_box.isEmpty() ? kInfinity : lowest_level(level_box, options.up.normalized()));
-  const Stage stage = make_stage(camera, options.up, box, level);
+                           : (level_box.isEmpty() ? kInfinity : lowest_level(level_box, up));
+  const Stage stage = make_stage(camera, up, box, level);
 
   std::vector<MeshArrays> cloth_arrays, obstacle_arrays;
-  for (const RenderMesh& m : cloths) cloth_arrays.push_back(prepare(m, options.wireframe, options.highlight_edges, stage));
+  for (const RenderMesh& m : cloths)
+    cloth_arrays.push_back(prepare(m, options.wireframe, options.highlight_edges, stage));
   for (const RenderMesh& m : obstacles) obstacle_arrays.push_back(prepare(m, false, false, stage));
 
-  Context& ctx = *context_;
-  ctx.make_current();
-  ctx.bind_target(options.samples);
-  glViewport(0, 0, width_, height_);
-  glDisable(GL_SCISSOR_TEST);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(GL_TRUE);
-  glStencilMask(0xff);
-  glClearColor(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2], 1);
-  glClearDepth(1);
-  glClearStencil(0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-  if (ctx.fbo) glEnable(GL_MULTISAMPLE);
-  glShadeModel(GL_SMOOTH);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_STENCIL_TEST);
-  glDisable(GL_BLEND);
-  glDisable(GL_POLYGON_OFFSET_FILL);
-  draw_background();
-
-  // Clipping planes just around everything that can be drawn (the ground reaches beyond the scene).
-  const double reach = std::max(stage.scene_radius, options.ground ? std::sqrt(2.0) * stage.ground_radius : 0.0);
-  const double distance = (camera.eye - box.center()).norm();
-  const double z_far = std::max(distance + 1.05 * reach, 1e-6);
-  const double z_near = std::max(z_far * 1e-3, distance - 1.05 * reach);
-  const Mat4 projection = projection_matrix(camera, double(width_) / double(height_), z_near, z_far);
-  const Mat4 view = view_matrix(camera);
-  glMatrixMode(GL_PROJECTION);
-  glLoadMatrixd(projection.data());
-  glMatrixMode(GL_MODELVIEW);
-  glLoadMatrixd(view.data());
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
+  const bool multisampled = context_->begin_frame(options.samples);
+  clear_to_background(width_, height_, multisampled);
+  const Mat4 view = load_camera(camera, stage, box, options.ground, double(width_) / double(height_));
+  set_lights(stage);
 
   // Ground and obstacles mark the stencil buffer: shadows are drawn only there, once per pixel.
   glEnable(GL_STENCIL_TEST);
@@ -330,79 +313,34 @@ void Renderer::render(const std::vector<RenderMesh>& cloths, const std::vector<R
   if (options.ground) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glPolygonOffset(4, 16);
+    glPolygonOffset(4, 16);  // behind everything resting on it
     draw_ground(stage);
     glDisable(GL_BLEND);
   }
-
-  const GLfloat ambient[4] = {0.30f, 0.30f, 0.30f, 1};
-  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
-  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
-  glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
-  set_light(GL_LIGHT0, stage.key_light, 0.72f, 0.25f);
-  set_light(GL_LIGHT1, stage.fill_light, 0.30f, 0.0f);
-  glColor4f(1, 1, 1, 1);
-
   glEnable(GL_LIGHTING);
   set_material(GL_FRONT_AND_BACK, kObstacle, 0.12f, 20);
-  glPolygonOffset(2, 4);
+  glPolygonOffset(2, 4);  // behind cloth lying on them
   for (const MeshArrays& a : obstacle_arrays) draw_triangles(a, true);
   glDisable(GL_LIGHTING);
-
-  if (options.ground && options.shadows) {
-    glStencilFunc(GL_EQUAL, 1, 0xff);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glColor4fv(kShadow);
-    glPolygonOffset(-1, -4);
-    const Mat4 shadow = view * planar_shadow_matrix(stage.up, stage.ground_level, stage.key_light);
-    glLoadMatrixd(shadow.data());
-    for (const auto* list : {&obstacle_arrays, &cloth_arrays})
-      for (const MeshArrays& a : *list)
-        if (a.casts_shadow) draw_triangles(a, false);
-    glLoadMatrixd(view.data());
-    glDisable(GL_BLEND);
-    glDepthMask(GL_TRUE);
-  }
+  if (options.ground && options.shadows) draw_shadows(stage, view, {&obstacle_arrays, &cloth_arrays});
   glDisable(GL_STENCIL_TEST);
 
   glEnable(GL_LIGHTING);
   set_material(GL_FRONT, kClothFront, 0.15f, 28);
   set_material(GL_BACK, kClothBack, 0.10f, 28);
-  glPolygonOffset(1, 1);
+  glPolygonOffset(1, 1);  // lets the lines drawn next win the depth test
   for (const MeshArrays& a : cloth_arrays) draw_triangles(a, true);
   glDisable(GL_LIGHTING);
   glDisable(GL_POLYGON_OFFSET_FILL);
+  draw_edges(cloth_arrays, options, height_);
 
-  // Lines sit exactly on the surfaces, which were pushed back by the polygon offset, so they win the depth test.
-  const GLfloat line_scale = GLfloat(std::max(1.0, height_ / 720.0));
-  if (options.wireframe) {
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glDepthMask(GL_FALSE);
-    glLineWidth(line_scale);
-    glColor4fv(kWire);
-    for (const MeshArrays& a : cloth_arrays) draw_lines(a, a.wire);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
-  }
-  if (options.highlight_edges) {
-    glLineWidth(2 * line_scale);
-    glColor4fv(kHighlight);
-    for (const MeshArrays& a : cloth_arrays) draw_lines(a, a.highlight);
-  }
-  glDisableClientState(GL_VERTEX_ARRAY);
-  glDisableClientState(GL_NORMAL_ARRAY);
-
-  ctx.finish();
+  context_->end_frame();
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) throw std::runtime_error("renderer: OpenGL error " + gl_error_text(error));
 
   const size_t row = size_t(width_) * 4;
   for (int y = 0; y < height_; ++y)
-    std::memcpy(&rgba_[size_t(y) * row], &ctx.buffer[size_t(height_ - 1 - y) * row], row);
+    std::memcpy(&rgba_[size_t(y) * row], &context_->pixels()[size_t(height_ - 1 - y) * row], row);
   for (size_t i = 3; i < rgba_.size(); i += 4) rgba_[i] = 255;
 }
 

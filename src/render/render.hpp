@@ -27,6 +27,8 @@
 
 namespace arcsim {
 
+class OffscreenContext;
+
 struct RenderOptions {
   Vec3 up = Vec3::UnitZ();          // world up (opposite to gravity): orients the ground plane and the lights
   bool ground = true;               // checkered ground plane below the scene, fading out at its border
@@ -62,8 +64,7 @@ class Renderer {
   const std::vector<uint8_t>& rgba() const { return rgba_; }
 
  private:
-  struct Context;
-  std::unique_ptr<Context> context_;
+  std::unique_ptr<OffscreenContext> context_;
   int width_, height_;
   std::vector<uint8_t> rgba_;
 };

@@ -315,17 +315,17 @@ TEST(FlipEdge, ReplacesDiagonalAndAveragesStateByArea) {
   EXPECT_EQ(check_mesh(m), "");
 }
 
-// A doubly curved (bowl) rest shape, so that no quad of the grid is planar.
-Mesh bowl_grid(int nx, int ny) {
+// A doubly curved (saddle) rest shape, so that no quad of the grid is planar.
+Mesh saddle_grid(int nx, int ny) {
   Mesh m = make_flat_grid(nx, ny);
-  for (Vert& v : m.verts) v.u.z() = 0.8 * (v.u.x() * v.u.x() + v.u.y() * v.u.y());
+  for (Vert& v : m.verts) v.u.z() = 0.8 * (v.u.x() - 0.5) * (v.u.y() - 0.5);
   for (Node& n : m.nodes) n.x = m.verts[n.verts[0]].u;
   m.update_rest_data();
   return m;
 }
 
 TEST(FlipEdge, CurvedRestShapeKeepsPlasticOffsets) {
-  Mesh m = bowl_grid(4, 3);
+  Mesh m = saddle_grid(4, 3);
   std::mt19937 rng(11);
   test::fill_random_state(m, rng);
   std::vector<double> offset(m.edges.size()), theta(m.edges.size());

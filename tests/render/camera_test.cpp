@@ -100,10 +100,11 @@ TEST(RenderCamera, FrameCameraKeepsAllCornersInside) {
   const Eigen::AlignedBox3d sheet(Vec3(0, 0, 0.5), Vec3(2, 1, 0.5));       // flat, off-centre
   const Eigen::AlignedBox3d hanging(Vec3(-0.5, 0, -1), Vec3(0.5, 0, 0));   // vertical flag
   const Eigen::AlignedBox3d tall(Vec3(10, 10, 0), Vec3(10.2, 10.3, 5));
-  for (const FramingCase& c : {FramingCase{cube, 16.0 / 9, Vec3::UnitZ()}, FramingCase{cube, 0.5, Vec3::UnitY()},
-                               FramingCase{sheet, 16.0 / 9, Vec3::UnitZ()}, FramingCase{sheet, 1.0, Vec3::UnitY()},
-                               FramingCase{hanging, 16.0 / 9, Vec3::UnitZ()}, FramingCase{tall, 16.0 / 9, Vec3::UnitZ()},
-                               FramingCase{tall, 16.0 / 9, -Vec3::UnitX()}}) {
+  const std::vector<FramingCase> cases = {
+      {cube, 16.0 / 9, Vec3::UnitZ()},    {cube, 0.5, Vec3::UnitY()},        {sheet, 16.0 / 9, Vec3::UnitZ()},
+      {sheet, 1.0, Vec3::UnitY()},        {hanging, 16.0 / 9, Vec3::UnitZ()}, {tall, 16.0 / 9, Vec3::UnitZ()},
+      {tall, 16.0 / 9, -Vec3::UnitX()}};
+  for (const FramingCase& c : cases) {
     SCOPED_TRACE(::testing::Message() << "box " << c.box.min().transpose() << " / " << c.box.max().transpose()
                                       << " aspect " << c.aspect << " up " << c.up.transpose());
     expect_framed(c);

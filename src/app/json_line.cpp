@@ -1,0 +1,50 @@
+#include "app/json_line.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace arcsim {
+
+std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  char buffer[40];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, x);
+    if (std::strtod(buffer, nullptr) == x) break;
+  }
+  return buffer;
+}
+
+void JsonLine::key(const char* name) {
+  if (!body_.empty()) body_ += ',';
+  body_ += '"';
+  body_ += name;
+  body_ += "\":";
+}
+
+JsonLine& JsonLine::number(const char* name, double x) {
+  key(name);
+  body_ += json_number(x);
+  return *this;
+}
+
+JsonLine& JsonLine::integer(const char* name, long long x) {
+  key(name);
+  body_ += std::to_string(x);
+  return *this;
+}
+
+JsonLine& JsonLine::boolean(const char* name, bool b) {
+  key(name);
+  body_ += b ? "true" : "false";
+  return *this;
+}
+
+JsonLine& JsonLine::object(const char* name, const JsonLine& inner) {
+  key(name);
+  body_ += inner.str();
+  return *this;
+}
+
+}  // namespace arcsim

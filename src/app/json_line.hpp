@@ -1,0 +1,26 @@
+// A minimal writer of one-line JSON objects whose keys keep the order they were added in (jsoncpp sorts keys,
+// which makes log lines harder to read). Keys are program constants and are not escaped.
+#pragma once
+
+#include <string>
+
+namespace arcsim {
+
+class JsonLine {
+ public:
+  // Shortest decimal form that reads back as the same double; null if not finite (JSON has no NaN/inf).
+  JsonLine& number(const char* key, double x);
+  JsonLine& integer(const char* key, long long x);
+  JsonLine& boolean(const char* key, bool b);
+  JsonLine& object(const char* key, const JsonLine& inner);
+  std::string str() const { return "{" + body_ + "}"; }
+
+ private:
+  void key(const char* name);
+  std::string body_;
+};
+
+// The number as JSON text (see JsonLine::number).
+std::string json_number(double x);
+
+}  // namespace arcsim

@@ -1,0 +1,181 @@
+#include "app/simulate_command.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <ostream>
+
+#include "app/arguments.hpp"
+#include "app/frame_report.hpp"
+#include "app/output.hpp"
+#include "app/progress.hpp"
+#include "io/errors.hpp"
+#include "io/scene_parser.hpp"
+#include "sim/simulation.hpp"
+
+namespace arcsim {
+
+const char kSimulateHelp[] =
+    "Usage: arcsim simulate <scene.json> [<out-dir>] [options]\n"
+    "\n"
+    "Runs the scene offline. With <out-dir>, writes into it (created if needed): conf.json and the files the\n"
+    "scene references (so that <out-dir>/conf.json runs on its own), NNNNN_CC.obj for every cloth at frame 0\n"
+    "and every saved frame, obstacles (obsCC.obj once if static, NNNNN_obsCC.obj per frame if moving) and\n"
+    "log.jsonl (one line per frame with wall times per module). Without <out-dir> nothing is written.\n"
+    "See docs/file-formats.md.\n"
+    "\n"
+    "Options (anywhere after the command):\n"
+    "  --end-time T      stop at simulated time T seconds (overrides the scene's end)\n"
+    "  --end-frame N     stop after frame N (overrides the scene's end)\n"
+    "  --threads N       use N OpenMP threads\n"
+    "  --quiet           print no warnings and no progress (errors only)\n"
+    "  --progress json   print one JSON object per frame on stdout (frame, total, time, faces, nodes, wall)\n"
+    "  --help, -h        show this help\n"
+    "\n"
+    "Exit codes: 0 success, 2 bad input (scene, mesh, arguments), 3 numerical failure (the frames written\n"
+    "before it are kept), 1 internal error.\n";
+
+namespace {
+
+const char kCommand[] = "simulate";
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void count_elements(const Simulation& sim, FrameReport& report) {
+  report.nodes = report.faces = 0;
+  for (const Cloth& c : sim.cloths) {
+    report.nodes += static_cast<long long>(c.mesh.nodes.size());
+    report.faces += static_cast<long long>(c.mesh.faces.size());
+  }
+}
+
+void copy_module_times(const ModuleTimes& times, FrameWallTimes& wall) {
+  wall.physics = times.physics;
+  wall.collision = times.collision;
+  wall.remeshing = times.remeshing;
+  wall.plasticity = times.plasticity;
+  wall.fracture = times.fracture;
+}
+
+}  // namespace
+
+SimulateOptions parse_simulate_options(const std::vector<std::string>& args) {
+  const std::vector<OptionSpec> specs = {
+      {"--end-time", true}, {"--end-frame", true}, {"--threads", true}, {"--quiet", false}, {"--progress", true}};
+  const ParsedArguments parsed = parse_arguments(args, specs, kCommand);
+  SimulateOptions options;
+  options.help = parsed.help;
+  if (options.help) return options;
+  for (const auto& [name, value] : parsed.options) {
+    if (name == "--end-time") {
+      options.end_time = number_argument(kCommand, name, value, 0);
+    } else if (name == "--end-frame") {
+      options.end_frame = integer_argument(kCommand, name, value, 0, 1000000000);
+    } else if (name == "--threads") {
+      options.threads = integer_argument(kCommand, name, value, 1, 1024);
+    } else if (name == "--quiet") {
+      options.quiet = true;
+    } else if (name == "--progress") {
+      if (value != "json")
+        throw InputError(std::string(kCommand) + ": --progress: the only style is 'json', got '" + value + "'");
+      options.json_progress = true;
+    }
+  }
+  const std::vector<std::string>& pos = parsed.positionals;
+  if (pos.empty())
+    throw InputError(std::string(kCommand) + ": missing the scene file (usage: arcsim simulate <scene.json> "
+                                             "[<out-dir>] [options])");
+  if (pos.size() > 2)
+    throw InputError(std::string(kCommand) + ": unexpected argument '" + pos[2] + "' (usage: arcsim simulate " +
+                     "<scene.json> [<out-dir>] [options])");
+  options.scene = pos[0];
+  if (pos.size() == 2) {
+    if (pos[1].empty()) throw InputError(std::string(kCommand) + ": the output folder name is empty");
+    options.out_dir = pos[1];
+  }
+  return options;
+}
+
+int run_simulate(const SimulateOptions& options, const Console& console) {
+  if (options.threads > 0) omp_set_num_threads(options.threads);
+
+  const Scene scene = load_scene(options.scene);
+  const auto warn = [&](const std::vector<std::string>& warnings) {
+    if (!options.quiet)
+      for (const std::string& w : warnings) console.warn(w);
+  };
+  warn(scene.warnings);
+  Simulation sim(scene);
+  if (options.end_time < kInfinity) sim.set_end_time(options.end_time);
+  if (options.end_frame < kInfinity) sim.set_end_frame(options.end_frame);
+
+  // Frame 0: the initial state.
+  std::unique_ptr<OutputFolder> out;
+  FrameReport report;
+  const auto start = std::chrono::steady_clock::now();
+  if (!options.out_dir.empty()) {
+    out = std::make_unique<OutputFolder>(options.out_dir);
+    warn(out->write_scene(scene));
+    out->write_static_obstacles(sim);
+    out->write_frame(sim);
+    report.saved = true;
+  }
+  report.frame = sim.frame();
+  report.time = sim.time();
+  count_elements(sim, report);
+  report.wall.output = report.wall.total = seconds_since(start);
+  if (out) out->log(frame_log_line(report));
+
+  const ProgressStyle style = choose_progress_style(options.quiet, options.json_progress, console.err_is_terminal);
+  Progress progress(style, console, sim.total_frames());
+  const int save_every = std::max(1, scene.save_every);
+  int last_saved = sim.frame();
+  try {
+    while (!sim.finished()) {
+      sim.times.clear();
+      const int first_step = sim.step();
+      const auto frame_start = std::chrono::steady_clock::now();
+      sim.advance_frame();
+      report = FrameReport();
+      report.frame = sim.frame();
+      report.time = sim.time();
+      report.steps = sim.step() - first_step;
+      count_elements(sim, report);
+      copy_module_times(sim.times, report.wall);
+      const auto output_start = std::chrono::steady_clock::now();
+      if (out && sim.step() % save_every == 0) {
+        out->write_frame(sim);
+        report.saved = true;
+        last_saved = sim.frame();
+      }
+      report.wall.output = seconds_since(output_start);
+      report.wall.total = seconds_since(frame_start);
+      if (out) out->log(frame_log_line(report));
+      progress.frame_done(report);
+    }
+  } catch (const NumericalError& e) {
+    progress.end_line();
+    std::string kept = out ? "; frames up to " + std::to_string(last_saved) + " are kept in " + out->dir() : "";
+    throw NumericalError(std::string(e.what()) + kept);
+  } catch (...) {
+    progress.end_line();
+    throw;
+  }
+  progress.summary(sim.frame(), sim.time(), options.out_dir);
+  return 0;
+}
+
+int run_simulate_command(const std::vector<std::string>& args, const Console& console) {
+  const SimulateOptions options = parse_simulate_options(args);
+  if (options.help) {
+    console.out << kSimulateHelp;
+    return 0;
+  }
+  return run_simulate(options, console);
+}
+
+}  // namespace arcsim

@@ -1,0 +1,35 @@
+// `arcsim simulate <scene.json> [<out-dir>] [options]`: runs a scene offline, writing every frame to out-dir.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "app/console.hpp"
+#include "math/types.hpp"
+
+namespace arcsim {
+
+extern const char kSimulateHelp[];
+
+struct SimulateOptions {
+  std::string scene;
+  std::string out_dir;           // "" = dry run: simulate, write nothing
+  double end_time = kInfinity;   // s; infinity keeps the scene's end
+  double end_frame = kInfinity;  // frames; infinity keeps the scene's end
+  int threads = 0;               // OpenMP threads; 0 = OpenMP's default
+  bool quiet = false;            // no warnings, no progress
+  bool json_progress = false;    // --progress json: one JSON object per frame on stdout
+  bool help = false;
+};
+
+// Parses the arguments after `simulate`. Throws InputError (exit 2) for bad ones.
+SimulateOptions parse_simulate_options(const std::vector<std::string>& args);
+
+// Runs the simulation; returns the exit code (0). Throws InputError / NumericalError as described in command.hpp;
+// after a NumericalError every frame written before the failure stays in the output folder.
+int run_simulate(const SimulateOptions& options, const Console& console);
+
+// The command-table entry: parse, then print help or run.
+int run_simulate_command(const std::vector<std::string>& args, const Console& console);
+
+}  // namespace arcsim

@@ -1,0 +1,223 @@
+#include "sim/simulation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "io/errors.hpp"
+#include "io/obj.hpp"
+
+namespace arcsim {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A speed no sheet reaches in a stable run (m/s); beyond it the step has diverged.
+constexpr double kUnstableSpeed = 1e4;
+
+}  // namespace
+
+double Handle::strength(double t) const {
+  if (t < start_time) return 0;
+  if (t <= end_time) return 1;
+  if (fade_time <= 0) return 0;
+  const double s = 1 - (t - end_time) / fade_time;
+  return s > 0 ? s * s * s * s : 0;
+}
+
+Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motions) {
+  step_time_ = scene.step_time;
+  frame_steps_ = scene.frame_steps;
+  end_time_ = scene.end_time;
+  end_frame_ = scene.end_frame;
+  for (Motion& m : motions_) m.finalize();
+  for (size_t i = 0; i < scene.cloths.size(); ++i) load_cloth(scene.cloths[i], static_cast<int>(i));
+  for (size_t i = 0; i < scene.obstacles.size(); ++i) load_obstacle(scene.obstacles[i], static_cast<int>(i));
+  for (size_t i = 0; i < scene.handles.size(); ++i) load_handle(scene.handles[i], static_cast<int>(i));
+  move_obstacles(0);
+  for (Obstacle& o : obstacles)
+    for (Node& n : o.mesh.nodes) n.v.setZero();
+}
+
+void Simulation::load_cloth(const ClothSpec& spec, int index) {
+  Cloth cloth;
+  cloth.source = spec.mesh;
+  cloth.materials = spec.materials;
+  cloth.remeshing = spec.remeshing;
+  cloth.mesh = load_obj_mesh(spec.mesh);
+  Mesh& mesh = cloth.mesh;
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    Face& face = mesh.faces[f];
+    if (face.material < 0 || face.material >= static_cast<int>(cloth.materials.size())) {
+      std::ostringstream msg;
+      msg << spec.mesh << ": face " << f + 1 << " uses material " << face.material << " but cloths[" << index
+          << "].materials has " << cloth.materials.size() << " entries";
+      throw InputError(msg.str());
+    }
+    if (face.thickness <= 0) face.thickness = cloth.materials[face.material].thickness;
+  }
+  // World placement; rest coordinates are scaled with the sheet (ARCSim). A curved reference shape takes the
+  // placed world shape as its rest shape.
+  for (Vert& v : mesh.verts) v.u *= spec.transform.scale;
+  for (Node& n : mesh.nodes) n.x = n.x0 = spec.transform.apply(n.x);
+  if (spec.reference != "linear")
+    for (Vert& v : mesh.verts) v.u = mesh.nodes[v.node].x;
+  mesh.update_rest_data();
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (!(mesh.faces[f].rest_area > 0)) {
+      std::ostringstream msg;
+      msg << spec.mesh << ": face " << f + 1 << " has zero rest area after the cloth transform";
+      throw InputError(msg.str());
+    }
+  }
+  const InitialVelocity& iv = spec.velocity;
+  for (Node& n : mesh.nodes) n.v = iv.linear + iv.angular.cross(n.x - iv.origin);
+  update_node_masses(mesh, cloth.materials);
+  cloths.push_back(std::move(cloth));
+}
+
+void Simulation::load_obstacle(const ObstacleSpec& spec, int index) {
+  Obstacle o;
+  o.source = spec.mesh;
+  o.mesh = load_obj_mesh(spec.mesh);
+  o.motion = spec.motion;
+  o.start_time = spec.start_time;
+  o.end_time = spec.end_time;
+  o.floor = spec.proxy == "floor";
+  for (Node& n : o.mesh.nodes) {
+    n.x = n.x0 = spec.transform.apply(n.x);
+    o.base.push_back(n.x);
+  }
+  obstacles.push_back(std::move(o));
+}
+
+void Simulation::load_handle(const HandleSpec& spec, int index) {
+  std::ostringstream where;
+  where << scene_.path << ": handles[" << index << "]";
+  if (spec.type != "node")
+    throw InputError(where.str() + ".type: handle type '" + spec.type +
+                     "' is not supported yet (node handles are)");
+  Handle h;
+  h.cloth = spec.cloth;
+  h.motion = spec.motion;
+  h.start_time = spec.start_time;
+  h.end_time = spec.end_time;
+  h.fade_time = spec.fade_time;
+  Mesh& mesh = cloths[spec.cloth].mesh;
+  if (spec.label >= 0) {
+    for (size_t n = 0; n < mesh.nodes.size(); ++n)
+      if (mesh.nodes[n].label == spec.label) h.nodes.push_back(static_cast<int>(n));
+    if (h.nodes.empty())
+      throw InputError(where.str() + ".label: no node of cloth " + std::to_string(spec.cloth) + " (" +
+                       cloths[spec.cloth].source + ") has label " + std::to_string(spec.label));
+  } else {
+    for (int n : spec.nodes) {
+      if (n < 0 || n >= static_cast<int>(mesh.nodes.size()))
+        throw InputError(where.str() + ".nodes: node " + std::to_string(n) + " is out of range (the mesh has " +
+                         std::to_string(mesh.nodes.size()) + " nodes)");
+      h.nodes.push_back(n);
+    }
+  }
+  for (int n : h.nodes) {
+    mesh.nodes[n].preserve = true;
+    h.anchors.push_back(mesh.nodes[n].x);
+  }
+  handles.push_back(std::move(h));
+}
+
+void Simulation::move_obstacles(double t) {
+  for (Obstacle& o : obstacles) {
+    o.active = t >= o.start_time && t <= o.end_time;
+    const Transform pose = o.motion >= 0 ? motions_[o.motion].pose(t) : Transform();
+    for (size_t i = 0; i < o.mesh.nodes.size(); ++i) {
+      Node& n = o.mesh.nodes[i];
+      n.x0 = n.x;
+      n.x = pose.apply(o.base[i]);
+      n.v = o.motion >= 0 ? motions_[o.motion].velocity(t, o.base[i]) : Vec3::Zero();
+    }
+  }
+}
+
+ExternalLoads Simulation::loads_for(int cloth, double t) const {
+  ExternalLoads loads;
+  loads.gravity = scene_.gravity;
+  loads.wind = scene_.wind;
+  for (const Handle& h : handles) {
+    if (h.cloth != cloth) continue;
+    const double strength = h.strength(t);
+    if (strength <= 0) continue;
+    const Transform pose = h.motion >= 0 ? motions_[h.motion].pose(t) : Transform();
+    for (size_t i = 0; i < h.nodes.size(); ++i)
+      loads.springs.push_back({h.nodes[i], pose.apply(h.anchors[i]), scene_.magic.handle_stiffness * strength});
+  }
+  return loads;
+}
+
+void Simulation::physics_step(double dt) {
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    Cloth& cloth = cloths[c];
+    if (cloth.elements_dirty) {
+      update_node_masses(cloth.mesh, cloth.materials);
+      build_element_cache(cloth.mesh, cloth.materials, cloth.elements);
+      cloth.elements_dirty = false;
+    }
+    implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads_for(static_cast<int>(c), time_), dt,
+                        &times.solver);
+  }
+}
+
+void Simulation::check_state() const {
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    const Mesh& mesh = cloths[c].mesh;
+    for (size_t n = 0; n < mesh.nodes.size(); ++n) {
+      const Node& node = mesh.nodes[n];
+      const bool finite = node.x.allFinite() && node.v.allFinite();
+      if (finite && node.v.norm() < kUnstableSpeed) continue;
+      std::ostringstream msg;
+      msg << "unstable at step " << step_ << " (t = " << time_ << " s): cloth " << c << " node " << n + 1
+          << (finite ? " moves faster than 1e4 m/s" : " has a non-finite position or velocity")
+          << "; try a smaller time step";
+      throw NumericalError(msg.str());
+    }
+  }
+}
+
+void Simulation::advance_step() {
+  const double dt = step_time_;
+  time_ += dt;
+  ++step_;
+  move_obstacles(time_);
+
+  auto t0 = std::chrono::steady_clock::now();
+  if (scene_.enabled("physics")) {
+    physics_step(dt);
+  } else {
+    for (Cloth& cloth : cloths)
+      for (Node& n : cloth.mesh.nodes) n.x0 = n.x;
+  }
+  times.physics += seconds_since(t0);
+  check_state();
+
+  if (step_ % frame_steps_ == 0) ++frame_;
+}
+
+void Simulation::advance_frame() {
+  do {
+    advance_step();
+  } while (step_ % frame_steps_ != 0);
+}
+
+bool Simulation::finished() const {
+  // Half a step of slack so that accumulated rounding in `time_` does not add a step.
+  return time_ >= end_time_ - 0.5 * step_time_ || frame_ >= end_frame_;
+}
+
+double Simulation::total_frames() const {
+  const double frame_time = step_time_ * frame_steps_;
+  return std::min(end_frame_, std::ceil(end_time_ / frame_time - 1e-9));
+}
+
+}  // namespace arcsim

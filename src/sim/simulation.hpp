@@ -1,0 +1,112 @@
+// The simulation: one object that owns every cloth, obstacle, handle and motion of a scene, and advances them
+// in time. advance_step() is the one place where the modules hook into the time step, in the paper's order
+// (§3.1): physics (implicit Euler with forces and handles), then (as they are added) collisions, plasticity,
+// fracture substepping, and remeshing at frame ends.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+#include "physics/cloth_physics.hpp"
+#include "scene/scene.hpp"
+
+namespace arcsim {
+
+struct Cloth {
+  Mesh mesh;
+  std::vector<Material> materials;
+  RemeshingParams remeshing;
+  std::string source;           // mesh file, for messages
+  ElementCache elements;        // physics data of the current topology
+  CholeskySolver solver;
+  bool elements_dirty = true;   // topology or rest state changed since the cache was built
+};
+
+struct Obstacle {
+  Mesh mesh;                    // world positions at the current time
+  std::vector<Vec3> base;       // positions after the scene transform, before the motion (m)
+  int motion = -1;
+  double start_time = 0, end_time = kInfinity;
+  bool floor = false;           // `proxy: "floor"`
+  bool active = true;
+  std::string source;
+};
+
+struct Handle {
+  int cloth = 0;
+  std::vector<int> nodes;       // node indices (kept valid through topology edits)
+  std::vector<Vec3> anchors;    // positions the nodes are held at before the motion is applied (m)
+  int motion = -1;
+  double start_time = 0, end_time = kInfinity, fade_time = 0;
+  // Strength in [0, 1] at time t: 0 before start, 1 until end, then (1 - (t - end)/fade)^4 over fade_time.
+  double strength(double t) const;
+};
+
+// Wall-clock seconds spent per module since the counters were last cleared.
+struct ModuleTimes {
+  double physics = 0, collision = 0, remeshing = 0, plasticity = 0, fracture = 0;
+  StepTiming solver;  // part of physics
+  void clear() { *this = ModuleTimes(); }
+};
+
+class Simulation {
+ public:
+  // Loads the scene's meshes and sets up the initial state (time 0, frame 0). Throws InputError naming the
+  // file and element for bad meshes or references.
+  explicit Simulation(const Scene& scene);
+
+  // One time step. Throws NumericalError (the state is then left as it was before the step's positions were
+  // committed only where stated; callers stop the run) if the step goes unstable.
+  void advance_step();
+  // Steps until the next frame boundary.
+  void advance_frame();
+  bool finished() const;
+
+  const Scene& scene() const { return scene_; }
+  double time() const { return time_; }
+  double step_time() const { return step_time_; }
+  int step() const { return step_; }
+  int frame() const { return frame_; }
+  int frame_steps() const { return frame_steps_; }
+  // Sets the clock from a saved state (io/state.hpp's load_state); nothing else changes.
+  void restore_clock(double time, int step, int frame) {
+    time_ = time;
+    step_ = step;
+    frame_ = frame;
+  }
+
+  std::vector<Cloth> cloths;
+  std::vector<Obstacle> obstacles;
+  std::vector<Handle> handles;
+  ModuleTimes times;
+
+  // Overrides of the scene's end (command-line options); infinity keeps the scene's value.
+  void set_end_time(double t) { end_time_ = t; }
+  void set_end_frame(double f) { end_frame_ = f; }
+  double end_time() const { return end_time_; }
+  double end_frame() const { return end_frame_; }
+  // Total number of frames the run will produce (infinity if unbounded).
+  double total_frames() const;
+
+ private:
+  void load_cloth(const ClothSpec& spec, int index);
+  void load_obstacle(const ObstacleSpec& spec, int index);
+  void load_handle(const HandleSpec& spec, int index);
+  void move_obstacles(double t);
+  ExternalLoads loads_for(int cloth, double t) const;
+  void physics_step(double dt);
+  void check_state() const;
+
+  Scene scene_;
+  std::vector<Motion> motions_;
+  double time_ = 0;
+  double step_time_ = 0;
+  int frame_steps_ = 1;
+  int step_ = 0;
+  int frame_ = 0;
+  double end_time_ = kInfinity;
+  double end_frame_ = kInfinity;
+};
+
+}  // namespace arcsim
