@@ -77,7 +77,9 @@ bin/arcsim-asan: $(call obj,asan,$(LIB_SRC) $(MAIN_SRC))
 	@mkdir -p bin
 	$(CXX) -fsanitize=address,undefined -o $@ $^ $(LIBS)
 
-bin/arcsim-bench: $(call obj,release,$(LIB_SRC) $(BENCH_SRC))
+SUPPORT_SRC := $(shell find tests/support -name '*.cpp' 2>/dev/null | sort)
+
+bin/arcsim-bench: $(call obj,release,$(LIB_SRC) $(BENCH_SRC) $(SUPPORT_SRC))
 	@mkdir -p bin
 	$(CXX) -o $@ $^ $(LIBS) -lbenchmark -lpthread
 

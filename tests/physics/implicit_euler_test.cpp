@@ -114,7 +114,9 @@ TEST(ImplicitEuler, UniformStretchGivesAnalyticStressAndEnergy) {
   EXPECT_NEAR(internal_energy(s.mesh, s.cache), 0.5 * area * (G11 * S11 + G22 * S22), 1e-9 * area * S11 * G11);
   const VecX f = internal_forces(s.mesh, s.cache);
   for (size_t i = 0; i < s.mesh.nodes.size(); ++i) {
-    if (!s.mesh.is_boundary_node(static_cast<int>(i))) EXPECT_LT(f.segment<3>(3 * i).norm(), 1e-9 * ks);
+    if (!s.mesh.is_boundary_node(static_cast<int>(i))) {
+      EXPECT_LT(f.segment<3>(3 * i).norm(), 1e-9 * ks);
+    }
   }
   // Boundary traction: the force on the right edge is the first Piola-Kirchhoff stress P11 = lx S11 times the
   // rest height (N), pulling back.

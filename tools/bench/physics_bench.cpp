@@ -1,0 +1,61 @@
+// Time per implicit step on flat sheets of 1k to 64k faces, split into assembly, factorisation and solve.
+// Run with `make bench`; docs/benchmarks.md records the figures.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "physics/cloth_physics.hpp"
+#include "support/mesh_factory.hpp"
+
+namespace arcsim {
+namespace {
+
+// A square sheet of about `faces` faces, 1 m wide, slightly wavy so that bending and membrane terms are active,
+// held at two corners and falling under gravity.
+struct BenchSheet {
+  Mesh mesh;
+  std::vector<Material> materials;
+  ElementCache cache;
+  CholeskySolver solver;
+  ExternalLoads loads;
+
+  explicit BenchSheet(int faces) {
+    const int n = static_cast<int>(std::lround(std::sqrt(faces / 2.0)));
+    mesh = testing::make_grid(n, n, 1.0, 1.0, testing::Diagonal::kAlternating);
+    Material m;
+    m.thickness = 1e-4;
+    m.density = 800;
+    m.youngs_modulus = 4e9;
+    m.poisson_ratio = 0.3;
+    m.damping = 1e-4;
+    materials = {m};
+    for (Face& f : mesh.faces) f.thickness = m.thickness;
+    for (Node& node : mesh.nodes) node.x.z() = 0.01 * std::sin(7 * node.x.x()) * std::cos(5 * node.x.y());
+    update_node_masses(mesh, materials);
+    build_element_cache(mesh, materials, cache);
+    loads.gravity = Vec3(0, 0, -9.8);
+    loads.springs.push_back({0, mesh.nodes[0].x, 1e3});
+    loads.springs.push_back({n, mesh.nodes[n].x, 1e3});
+  }
+};
+
+void BM_ImplicitStep(benchmark::State& state) {
+  BenchSheet sheet(static_cast<int>(state.range(0)));
+  const double dt = 1e-3;
+  implicit_euler_step(sheet.mesh, sheet.cache, sheet.solver, sheet.loads, dt);  // symbolic analysis, once
+  StepTiming timing;
+  for (auto _ : state) implicit_euler_step(sheet.mesh, sheet.cache, sheet.solver, sheet.loads, dt, &timing);
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["faces"] = static_cast<double>(sheet.mesh.faces.size());
+  state.counters["assembly_ms"] = 1e3 * timing.assembly / steps;
+  state.counters["factor_ms"] = 1e3 * timing.factorization / steps;
+  state.counters["solve_ms"] = 1e3 * timing.solve / steps;
+  state.counters["assembly_share"] = timing.assembly / (timing.assembly + timing.factorization + timing.solve);
+}
+BENCHMARK(BM_ImplicitStep)->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+}  // namespace
+}  // namespace arcsim
+
+BENCHMARK_MAIN();
