@@ -7,6 +7,8 @@ PACKAGES=(
   g++ make pkg-config
   libeigen3-dev            # dense/sparse linear algebra, CholmodSupport
   libsuitesparse-dev       # CHOLMOD sparse Cholesky
+  libopenblas0-serial      # fast BLAS for CHOLMOD's supernodal factorisation; single-threaded, so results do
+                           # not depend on the thread count (determinism)
   libnlopt-dev libnlopt-cxx-dev  # impact-zone constrained optimisation
   libjsoncpp-dev           # scene files
   libpng-dev               # replay frames
