@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -11,6 +12,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "app/json_line.hpp"
 #include "app/output_files.hpp"
 #include "io/errors.hpp"
 #include "io/scene_parser.hpp"
@@ -91,14 +93,16 @@ std::string resolve_like_loader(const std::string& name, const std::string& scen
 // Plans the copies: which source file goes to which path inside the output folder.
 class CopyPlan {
  public:
-  CopyPlan(const Scene& scene) : scene_(scene) {
+  explicit CopyPlan(const Scene& scene) : scene_(scene) {
     for (const std::string& f : scene.referenced_files) referenced_.insert(identity_of(f));
   }
 
   // Walks the scene's JSON, planning a copy for every string that names a referenced file and rewriting the
   // strings that must point into files/. Returns true if the JSON was changed.
   bool plan(Json::Value& root) {
-    if (root.isObject() && root["obstacles"].isString()) plan_obstacle_pattern(root["obstacles"]);
+    // (isMember first: operator[] on a missing key would add it as null.)
+    if (root.isObject() && root.isMember("obstacles") && root["obstacles"].isString())
+      plan_obstacle_pattern(root["obstacles"]);
     walk(root, &root);
     return rewritten_;
   }
@@ -207,6 +211,56 @@ Json::Value read_scene_json(const std::string& path) {
   return root;
 }
 
+// JSON text of `value` for a rewritten scene: numbers in their shortest exact form (jsoncpp's writer prints
+// 0.3 as 0.29999999999999999), infinities as the loader's Infinity, arrays of scalars on one line.
+void append_json(const Json::Value& value, const std::string& indent, std::string& out) {
+  switch (value.type()) {
+    case Json::nullValue:
+      out += "null";
+      return;
+    case Json::booleanValue:
+      out += value.asBool() ? "true" : "false";
+      return;
+    case Json::intValue:
+    case Json::uintValue:
+      out += value.isInt64() ? std::to_string(value.asInt64()) : std::to_string(value.asUInt64());
+      return;
+    case Json::realValue: {
+      const double x = value.asDouble();
+      out += std::isinf(x) ? (x > 0 ? "Infinity" : "-Infinity") : json_number(x);
+      return;
+    }
+    case Json::stringValue:
+      out += Json::valueToQuotedString(value.asCString());
+      return;
+    case Json::arrayValue: {
+      const bool flat = std::none_of(value.begin(), value.end(), [](const Json::Value& v) {
+        return v.isArray() || v.isObject();
+      });
+      const std::string inner = indent + "    ";
+      out += '[';
+      for (Json::ArrayIndex i = 0; i < value.size(); ++i) {
+        out += i > 0 ? (flat ? ", " : ",\n" + inner) : (flat ? "" : "\n" + inner);
+        append_json(value[i], inner, out);
+      }
+      out += flat || value.empty() ? "]" : "\n" + indent + "]";
+      return;
+    }
+    case Json::objectValue: {
+      const std::string inner = indent + "    ";
+      out += '{';
+      bool first = true;
+      for (const std::string& key : value.getMemberNames()) {
+        out += (first ? "\n" : ",\n") + inner + Json::valueToQuotedString(key.c_str()) + ": ";
+        append_json(value[key], inner, out);
+        first = false;
+      }
+      out += value.empty() ? "}" : "\n" + indent + "}";
+      return;
+    }
+  }
+}
+
 [[noreturn]] void cannot_write(const std::string& path, const std::error_code& ec) {
   throw InputError(path + ": cannot write (" + ec.message() + ")");
 }
@@ -254,15 +308,13 @@ std::vector<std::string> copy_scene_files(const Scene& scene, const std::string&
 
   const std::string conf = (fs::path(out_dir) / kSceneCopyName).string();
   if (rewritten) {
-    Json::StreamWriterBuilder writer;
-    writer["indentation"] = "    ";
-    writer["useSpecialFloats"] = true;  // Infinity stays Infinity (the loader accepts it where it means "off")
-    writer["precision"] = 17;
+    std::string json;
+    append_json(root, "", json);
     std::ostringstream text;
     std::string from = scene.path;
     std::replace(from.begin(), from.end(), '\n', ' ');
     text << "// Copied by arcsim simulate from " << from << ", with paths rewritten into this folder.\n"
-         << Json::writeString(writer, root) << "\n";
+         << json << "\n";
     write_text_atomically(conf, text.str());
   } else {
     copy_file_atomically(scene.path, conf);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <ostream>
 
@@ -112,6 +113,9 @@ int run_simulate(const SimulateOptions& options, const Console& console) {
   Simulation sim(scene);
   if (options.end_time < kInfinity) sim.set_end_time(options.end_time);
   if (options.end_frame < kInfinity) sim.set_end_frame(options.end_frame);
+  if (!std::isfinite(sim.total_frames()))
+    warn({options.scene + ": the scene sets no end_time or end_frame (nor duration): the run goes on until it is "
+                          "interrupted; --end-time or --end-frame set one"});
 
   // Frame 0: the initial state.
   std::unique_ptr<OutputFolder> out;
@@ -124,15 +128,24 @@ int run_simulate(const SimulateOptions& options, const Console& console) {
     out->write_frame(sim);
     report.saved = true;
   }
+  describe_frame(sim, report);
+  report.wall.output = report.wall.total = seconds_since(start);
+  if (out) out->log(frame_log_line(report));
+  run_frames(sim, out.get(), options, console);
+  return 0;
+}
+
+void describe_frame(const Simulation& sim, FrameReport& report) {
   report.frame = sim.frame();
   report.time = sim.time();
   count_elements(sim, report);
-  report.wall.output = report.wall.total = seconds_since(start);
-  if (out) out->log(frame_log_line(report));
+  copy_module_times(sim.times, report.wall);
+}
 
+void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {
   const ProgressStyle style = choose_progress_style(options.quiet, options.json_progress, console.err_is_terminal);
   Progress progress(style, console, sim.total_frames());
-  const int save_every = std::max(1, scene.save_every);
+  const int save_every = std::max(1, sim.scene().save_every);
   int last_saved = sim.frame();
   try {
     while (!sim.finished()) {
@@ -140,12 +153,9 @@ int run_simulate(const SimulateOptions& options, const Console& console) {
       const int first_step = sim.step();
       const auto frame_start = std::chrono::steady_clock::now();
       sim.advance_frame();
-      report = FrameReport();
-      report.frame = sim.frame();
-      report.time = sim.time();
+      FrameReport report;
+      describe_frame(sim, report);
       report.steps = sim.step() - first_step;
-      count_elements(sim, report);
-      copy_module_times(sim.times, report.wall);
       const auto output_start = std::chrono::steady_clock::now();
       if (out && sim.step() % save_every == 0) {
         out->write_frame(sim);
@@ -165,8 +175,7 @@ int run_simulate(const SimulateOptions& options, const Console& console) {
     progress.end_line();
     throw;
   }
-  progress.summary(sim.frame(), sim.time(), options.out_dir);
-  return 0;
+  progress.summary(sim.frame(), sim.time(), out ? out->dir() : std::string());
 }
 
 int run_simulate_command(const std::vector<std::string>& args, const Console& console) {

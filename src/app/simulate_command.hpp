@@ -29,6 +29,18 @@ SimulateOptions parse_simulate_options(const std::vector<std::string>& args);
 // after a NumericalError every frame written before the failure stays in the output folder.
 int run_simulate(const SimulateOptions& options, const Console& console);
 
+class OutputFolder;
+class Simulation;
+
+// The frame loop shared by simulate and resume: advances `sim` to its end, writing every saved frame (and its
+// state file) to `out` (may be null), logging and reporting progress. Keeps frames written before a
+// NumericalError and rethrows it with where they are.
+void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console);
+
+// Counts and module wall times of the current frame, for log.jsonl and progress.
+struct FrameReport;
+void describe_frame(const Simulation& sim, FrameReport& report);
+
 // The command-table entry: parse, then print help or run.
 int run_simulate_command(const std::vector<std::string>& args, const Console& console);
 

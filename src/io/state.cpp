@@ -3,11 +3,13 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -269,7 +271,7 @@ void write_cloths(const Simulation& sim, StateWriter& w) {
 }
 
 void read_cloths(StateReader& r, StagedState& s) {
-  s.cloths.resize(r.get_count(4 * 5));
+  s.cloths.resize(r.get_count(5 * 4));  // material count and four element counts
   for (StagedCloth& cloth : s.cloths) {
     cloth.material_count = r.get_u32();
     cloth.mesh = read_mesh(r);
@@ -290,7 +292,7 @@ void write_obstacles(const Simulation& sim, StateWriter& w) {
 }
 
 void read_obstacles(StateReader& r, StagedState& s) {
-  s.obstacles.resize(r.get_count(4 + 1));
+  s.obstacles.resize(r.get_count(4 + 1));  // node count, active
   for (StagedObstacle& o : s.obstacles) {
     const size_t count = r.get_count(kObstacleNodeBytes);
     o.x.resize(count);
@@ -321,7 +323,7 @@ void write_handles(const Simulation& sim, StateWriter& w) {
 }
 
 void read_handles(StateReader& r, StagedState& s) {
-  s.handles.resize(r.get_count(4 + 4));
+  s.handles.resize(r.get_count(4 + 4));  // cloth, node count
   for (StagedHandle& h : s.handles) {
     h.cloth = r.get_i32();
     const size_t count = r.get_count(4 + 3 * 8);

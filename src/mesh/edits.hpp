@@ -48,16 +48,17 @@ EditResult flip_edge(Mesh& mesh, int edge);
 // Surviving faces keep their state; edges whose wings change keep their plastic offset (see flip_edge).
 EditResult collapse_edge(Mesh& mesh, int edge, int remove_side);
 
-// Vertex split for a crack at `node` along 1 or 2 interior `cut_edges` incident to it. The faces around the
-// node are divided into sectors by the cut edges (and, for a boundary node, by the boundary); the sector that
-// starts at the sheet boundary (boundary node) or the one from cut_edges[1] counter-clockwise to cut_edges[0]
-// (interior node) stays, every other sector moves to a new copy of the node with new rest verts; so the sector
-// walking CCW from cut_edges[0] to cut_edges[1] (interior node), or from the cut edge to the boundary (boundary
-// node, one cut edge), moves. Each cut edge becomes two boundary edges (copies of rest_theta, damage, preserve).
-// A far end of a cut edge that was already on the boundary is split too, so that every node keeps a single fan.
-// New nodes copy x, x0, v, a, label and mass; the split nodes and their copies get preserve = true.
-// added_nodes lists the copies of `node` first, then those of far ends. Refused for an edge that is not
-// incident, already on the boundary, repeated, or a single cut edge at an interior node.
+// Vertex split for a crack at `node` along 1 or 2 interior `cut_edges` incident to it. The cut edges (and, for a
+// boundary node, the boundary) divide the faces around the node into sectors; one sector stays with the node and
+// every other one moves to a new copy of it, with new rest verts. What moves: interior node, the sector walking
+// CCW from cut_edges[0] to cut_edges[1]; boundary node with one cut, the sector walking CCW from the cut edge to
+// the boundary; boundary node with two cuts, both sectors after the first cut in CCW order from the boundary
+// (two copies). Each cut edge becomes two boundary edges (copies of rest_theta, damage, preserve). A far end of
+// a cut edge that was already on the boundary would become a bow-tie, so it is split too (its part on the moving
+// side goes to a copy). New nodes copy x, x0, v, a, label and mass; every split node and copy gets
+// preserve = true. added_nodes lists the copies of `node` first, then those of far ends. Refused for an edge
+// that is not incident, already on the boundary, repeated, more than two edges, or a single cut edge at an
+// interior node.
 EditResult split_node(Mesh& mesh, int node, const std::vector<int>& cut_edges);
 
 // One face around a node: the node is corner `corner` of `face`; edge_out joins it to the next corner,

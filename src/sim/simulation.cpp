@@ -63,8 +63,21 @@ void Simulation::load_cloth(const ClothSpec& spec, int index) {
   // placed world shape as its rest shape.
   for (Vert& v : mesh.verts) v.u *= spec.transform.scale;
   for (Node& n : mesh.nodes) n.x = n.x0 = spec.transform.apply(n.x);
-  if (spec.reference != "linear")
+  if (spec.reference != "linear") {
+    // The placed world shape becomes the rest shape; edge rest angles follow it, keeping any plastic offset the
+    // file gave (rest angle minus the rest dihedral).
+    std::vector<double> plastic_offset(mesh.edges.size());
+    for (size_t e = 0; e < mesh.edges.size(); ++e)
+      plastic_offset[e] = mesh.edges[e].rest_theta - mesh.rest_dihedral(static_cast<int>(e));
     for (Vert& v : mesh.verts) v.u = mesh.nodes[v.node].x;
+    for (size_t e = 0; e < mesh.edges.size(); ++e)
+      mesh.edges[e].rest_theta = mesh.rest_dihedral(static_cast<int>(e)) + plastic_offset[e];
+  }
+  // The reference surface keeps a curved rest shape through remeshing; "sphere" also moves rest and world
+  // positions onto the fitted sphere (ARCSim).
+  cloth.reference = choose_reference(spec.reference, mesh, spec.transform,
+                                     scene_.path + ": cloths[" + std::to_string(index) + "].reference");
+  reproject_rest_positions(mesh, *cloth.reference);
   mesh.update_rest_data();
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     if (!(mesh.faces[f].rest_area > 0)) {
@@ -156,17 +169,68 @@ ExternalLoads Simulation::loads_for(int cloth, double t) const {
   return loads;
 }
 
-void Simulation::physics_step(double dt) {
+void Simulation::refresh_elements() {
+  for (Cloth& cloth : cloths) {
+    if (!cloth.elements_dirty) continue;
+    update_node_masses(cloth.mesh, cloth.materials);
+    build_element_cache(cloth.mesh, cloth.materials, cloth.elements);
+    cloth.elements_dirty = false;
+  }
+}
+
+void Simulation::physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts) {
+  refresh_elements();
   for (size_t c = 0; c < cloths.size(); ++c) {
     Cloth& cloth = cloths[c];
-    if (cloth.elements_dirty) {
-      update_node_masses(cloth.mesh, cloth.materials);
-      build_element_cache(cloth.mesh, cloth.materials, cloth.elements);
-      cloth.elements_dirty = false;
-    }
-    implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads_for(static_cast<int>(c), time_), dt,
-                        &times.solver);
+    ExternalLoads loads = loads_for(static_cast<int>(c), time_);
+    if (c < contacts.size()) loads.contacts = std::move(contacts[c]);
+    update_contact_pattern(cloth.elements, loads.contacts);
+    implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads, dt, &times.solver);
   }
+}
+
+CollisionSettings Simulation::collision_settings() const {
+  CollisionSettings s;
+  const MagicParams& magic = scene_.magic;
+  s.repulsion_thickness = magic.repulsion_thickness;
+  s.projection_thickness =
+      magic.projection_thickness >= 0 ? magic.projection_thickness : 0.1 * magic.repulsion_thickness;
+  s.stiffness = magic.collision_stiffness;
+  s.friction = scene_.friction;
+  s.obstacle_friction = scene_.obs_friction;
+  s.step = step_;
+  // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
+  for (const Obstacle& o : obstacles) {
+    if (!o.floor || !o.active) continue;
+    for (const Node& n : o.mesh.nodes) {
+      s.floor_height = s.floor ? std::min(s.floor_height, n.x.y()) : n.x.y();
+      s.floor = true;
+    }
+  }
+  return s;
+}
+
+namespace {
+
+std::vector<const Mesh*> active_obstacle_meshes(const std::vector<Obstacle>& obstacles) {
+  std::vector<const Mesh*> meshes;
+  for (const Obstacle& o : obstacles)
+    if (o.active) meshes.push_back(&o.mesh);
+  return meshes;
+}
+
+}  // namespace
+
+std::vector<std::vector<ContactTerm>> Simulation::proximity_step(double dt) {
+  std::vector<const Mesh*> cloth_meshes;
+  for (const Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
+  return collisions_.proximity_terms(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
+}
+
+void Simulation::collision_step(double dt) {
+  std::vector<Mesh*> cloth_meshes;
+  for (Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
+  collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
 }
 
 void Simulation::check_state() const {
@@ -191,14 +255,26 @@ void Simulation::advance_step() {
   ++step_;
   move_obstacles(time_);
 
+  // Proximity forces enter the implicit solve; the impact-zone response follows the position update.
+  refresh_elements();
   auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::vector<ContactTerm>> contacts;
+  if (scene_.enabled("proximity") && scene_.enabled("physics")) contacts = proximity_step(dt);
+  times.collision += seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
   if (scene_.enabled("physics")) {
-    physics_step(dt);
+    physics_step(dt, std::move(contacts));
   } else {
     for (Cloth& cloth : cloths)
       for (Node& n : cloth.mesh.nodes) n.x0 = n.x;
   }
   times.physics += seconds_since(t0);
+  check_state();
+
+  t0 = std::chrono::steady_clock::now();
+  if (scene_.enabled("collision")) collision_step(dt);
+  times.collision += seconds_since(t0);
   check_state();
 
   if (step_ % frame_steps_ == 0) ++frame_;

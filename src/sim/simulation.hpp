@@ -4,11 +4,14 @@
 // fracture substepping, and remeshing at frame ends.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "collision/collision_step.hpp"
 #include "mesh/mesh.hpp"
 #include "physics/cloth_physics.hpp"
+#include "restshape/reference_surface.hpp"
 #include "scene/scene.hpp"
 
 namespace arcsim {
@@ -21,6 +24,7 @@ struct Cloth {
   ElementCache elements;        // physics data of the current topology
   CholeskySolver solver;
   bool elements_dirty = true;   // topology or rest state changed since the cache was built
+  std::shared_ptr<const ReferenceSurface> reference;  // where remeshing puts new rest positions (restshape/)
 };
 
 struct Obstacle {
@@ -95,7 +99,12 @@ class Simulation {
   void load_handle(const HandleSpec& spec, int index);
   void move_obstacles(double t);
   ExternalLoads loads_for(int cloth, double t) const;
-  void physics_step(double dt);
+  void refresh_elements();
+  CollisionSettings collision_settings() const;
+  // Proximity terms per cloth (empty lists when the module is disabled).
+  std::vector<std::vector<ContactTerm>> proximity_step(double dt);
+  void physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts);
+  void collision_step(double dt);
   void check_state() const;
 
   Scene scene_;
@@ -107,6 +116,7 @@ class Simulation {
   int frame_ = 0;
   double end_time_ = kInfinity;
   double end_frame_ = kInfinity;
+  CollisionHandler collisions_;
 };
 
 }  // namespace arcsim

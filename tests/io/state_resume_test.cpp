@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "io/scene_parser.hpp"
 #include "io/state.hpp"
@@ -44,16 +45,21 @@ struct TempDir {
   }
 };
 
-// 10 x 10 cell sheet in the xy plane hanging from corner node 0 under gravity along -z; the handle and a strip
+// 10 x 10 cell sheet in the xy plane held at corner node 0, under gravity along -z; the handle and a strip
 // obstacle below follow one keyframed motion, so handle targets and obstacle velocities change every step.
-std::string hanging_sheet_scene(const fs::path& meshes) {
+// Without contact the collision modules are off (fast under the sanitizers); with contact the sheet is thrown
+// down onto the strip 5 mm below it, so proximity and impact-zone responses shape the state.
+std::string held_sheet_scene(const fs::path& meshes, bool contact) {
+  const std::string disable = contact ? R"(["remeshing"])" : R"(["remeshing", "proximity", "collision"])";
+  const std::string velocity = contact ? "[0, 0, -1]" : "[0.1, 0, 0.2]";
+  const std::string obstacle_at = contact ? "[0, 0.45, -0.005]" : "[0, 0, -0.5]";
   return R"({
     "frame_time": 0.01, "frame_steps": 4, "end_time": 10,
-    "disable": ["remeshing"],
+    "disable": )" + disable + R"(,
     "gravity": [0, 0, -9.8],
     "cloths": [{
       "mesh": ")" + (meshes / "square.obj").string() + R"(",
-      "velocity": {"linear": [0.1, 0, 0.2], "angular": [0, 0, 0.5]},
+      "velocity": {"linear": )" + velocity + R"(, "angular": [0, 0, 0.5]},
       "materials": [{"thickness": 1e-3, "density": 500, "elastic_modulus": 2e7, "poisson_ratio": 0.3,
                      "damping": 1e-3}]
     }],
@@ -64,7 +70,7 @@ std::string hanging_sheet_scene(const fs::path& meshes) {
     ]],
     "handles": [{"nodes": [0], "motion": 0}],
     "obstacles": [{"mesh": ")" + (meshes / "strip.obj").string() + R"(",
-                   "transform": {"translate": [0, 0, -0.5]}, "motion": 0}]
+                   "transform": {"translate": )" + obstacle_at + R"(}, "motion": 0}]
   })";
 }
 
@@ -73,18 +79,20 @@ bool same_bits(const Vec3& a, const Vec3& b) { return std::memcmp(a.data(), b.da
 
 class StateResume : public ::testing::Test {
  protected:
-  void SetUp() override {
+  void SetUp() override { scene_ = make_scene(false); }
+  Scene make_scene(bool contact) {
     const fs::path meshes = project_meshes();
-    ASSERT_FALSE(meshes.empty()) << "meshes/square.obj not found (run tests from the repository root)";
-    ASSERT_FALSE(dir_.path.empty());
-    scene_path_ = (dir_.path / "scene.json").string();
-    std::ofstream(scene_path_) << hanging_sheet_scene(meshes);
-    scene_ = load_scene(scene_path_);
+    EXPECT_FALSE(meshes.empty()) << "meshes/square.obj not found (run tests from the repository root)";
+    EXPECT_FALSE(dir_.path.empty());
+    const std::string scene_path = (dir_.path / "scene.json").string();
+    std::ofstream(scene_path) << held_sheet_scene(meshes, contact);
+    return load_scene(scene_path);
   }
   TempDir dir_;
-  std::string scene_path_;
   Scene scene_;
 };
+// The same with contact; slow under the sanitizers (collision detection every step).
+class StateResumeSlow : public StateResume {};
 
 void expect_same_state(const Simulation& a, const Simulation& b) {
   const double ta = a.time(), tb = b.time();
@@ -118,26 +126,40 @@ void expect_same_state(const Simulation& a, const Simulation& b) {
     }
 }
 
-TEST_F(StateResume, TwentyPlusTwentyStepsEqualFortyBitForBit) {
-  Simulation straight(scene_);
-  for (int i = 0; i < 40; ++i) straight.advance_step();
-
-  const std::string state = (dir_.path / "00005.state").string();
+// Runs 2 * half steps straight, and half + save + load into a fresh Simulation + half; the two must agree bit
+// for bit. Returns the straight run's final positions of the sheet.
+std::vector<Vec3> expect_resume_identical(const Scene& scene, const std::string& state, int half) {
+  Simulation straight(scene);
+  for (int i = 0; i < 2 * half; ++i) straight.advance_step();
   {
-    Simulation first_half(scene_);
-    for (int i = 0; i < 20; ++i) first_half.advance_step();
+    Simulation first_half(scene);
+    for (int i = 0; i < half; ++i) first_half.advance_step();
     save_state(first_half, state);
   }
-  Simulation resumed(scene_);
+  Simulation resumed(scene);
   load_state(resumed, state);
-  EXPECT_EQ(resumed.step(), 20);
-  EXPECT_EQ(resumed.frame(), 5);
-  for (int i = 0; i < 20; ++i) resumed.advance_step();
+  EXPECT_EQ(resumed.step(), half);
+  EXPECT_EQ(resumed.frame(), half / scene.frame_steps);
+  for (int i = 0; i < half; ++i) resumed.advance_step();
 
-  // The sheet really moved (so equality is not trivial): the handle dragged it and gravity pulled it.
-  const Simulation fresh(scene_);
+  // The sheet really moved (so equality is not trivial).
+  const Simulation fresh(scene);
   EXPECT_GT((straight.cloths[0].mesh.nodes[60].x - fresh.cloths[0].mesh.nodes[60].x).norm(), 1e-3);
   expect_same_state(straight, resumed);
+  std::vector<Vec3> x;
+  for (const Node& n : straight.cloths[0].mesh.nodes) x.push_back(n.x);
+  return x;
+}
+
+TEST_F(StateResume, TwentyPlusTwentyStepsEqualFortyBitForBit) {
+  expect_resume_identical(scene_, (dir_.path / "00005.state").string(), 20);
+}
+
+TEST_F(StateResumeSlow, WithContactAgainstAMovingObstacle) {
+  const std::vector<Vec3> x = expect_resume_identical(make_scene(true), (dir_.path / "00002.state").string(), 8);
+  // The strip, 5 mm below the middle row of the sheet, stopped that row: falling freely for 0.04 s from 1 m/s
+  // it would be about 5 cm lower.
+  EXPECT_GT(x[5 * 11 + 5].z(), -0.02);
 }
 
 TEST_F(StateResume, ResumingTwiceInARowStaysIdentical) {

@@ -49,23 +49,21 @@ std::string check_state_bounds(const Mesh& m, const Bounds& b, Shape shape) {
     if (!((f.Fp - Mat3::Identity()).cwiseAbs().maxCoeff() <= 0.1 + eps)) return where.str() + "Fp";
     if (!(f.Sp.cwiseAbs().maxCoeff() <= 1 + eps)) return where.str() + "Sp";
     if (!(f.material == 0 || f.material == 1)) return where.str() + "material";
-    // No face is ever inverted: planar rest shapes keep +z normals, the cylinder keeps outward ones.
-    if (shape == Shape::kCylinder) {
-      Vec3 centroid = Vec3::Zero();
-      for (int c = 0; c < 3; ++c) centroid += m.verts[f.v[c]].u / 3;
-      const Vec3 radial(centroid.x(), 0, centroid.z());
-      if (!(f.rest_normal.dot(radial) > 0)) return where.str() + "inverted on the cylinder";
-    } else if (!(f.rest_normal.z() > 0)) {
-      return where.str() + "inverted in the rest plane";
-    }
+    // No face is ever inverted: planar rest shapes keep +z normals (see also check_new_faces_follow_old).
+    if (shape != Shape::kCylinder && !(f.rest_normal.z() > 0)) return where.str() + "inverted in the rest plane";
   }
   for (size_t i = 0; i < m.edges.size(); ++i) {
     const Edge& e = m.edges[i];
     if (e.dead) continue;
     if (!(e.damage >= -eps && e.damage <= 1 + eps)) return "edge " + std::to_string(i) + ": damage";
-    // Planar rest: every rest dihedral is 0, so rest_theta is the plastic offset, which stays in [-0.1, 0.1].
+    // The plastic offset (rest_theta minus rest dihedral) starts in [-0.1, 0.1] and edits carry it over; on
+    // planar rest shapes every rest dihedral is 0, so the bound holds for rest_theta itself. (Crack lips keep
+    // the angle they had as interior edges, so on curved shapes boundary edges are exempt.)
+    const double offset = e.rest_theta - m.rest_dihedral(static_cast<int>(i));
     if (shape != Shape::kCylinder && !(std::abs(e.rest_theta) <= 0.1 + eps))
       return "edge " + std::to_string(i) + ": rest_theta";
+    if (!e.is_boundary() && !(std::abs(offset) <= 0.1 + 1e-9))
+      return "edge " + std::to_string(i) + ": plastic offset of rest_theta";
   }
   for (size_t i = 0; i < m.nodes.size(); ++i) {
     const Node& n = m.nodes[i];
@@ -96,6 +94,18 @@ std::string check_result_lists(const Mesh& m, const EditResult& r) {
     if (!m.edges.at(i).dead) return "removed edge alive";
   for (int i : r.removed_faces)
     if (!m.faces.at(i).dead) return "removed face alive";
+  return "";
+}
+
+// Each new face turns its rest normal by at most 60 degrees from a face it replaced (removed faces keep their
+// data as tombstones). On a curved sheet this is the local form of "never inverted".
+std::string check_new_faces_follow_old(const Mesh& m, const EditResult& r) {
+  if (r.removed_faces.empty()) return "";
+  for (int a : r.added_faces) {
+    double best = -1;
+    for (int f : r.removed_faces) best = std::max(best, m.faces[a].rest_normal.dot(m.faces[f].rest_normal));
+    if (!(best >= 0.5 - 1e-9)) return "face " + std::to_string(a) + " turned away from the faces it replaced";
+  }
   return "";
 }
 
@@ -149,7 +159,7 @@ Counts run_random_edits(Shape shape, unsigned seed, int steps, double fracture_r
   EXPECT_EQ(check_mesh(m), "");
   Counts counts;
   std::uniform_real_distribution<double> unit(0, 1);
-  const int face_cap = 400, face_floor = 40;
+  const int face_cap = 200, face_floor = 40;
   double area = test::total_rest_area(m);
   for (int step = 0; step < steps; ++step) {
     const uint64_t before = fingerprint(m);
@@ -209,7 +219,7 @@ Counts run_random_edits(Shape shape, unsigned seed, int steps, double fracture_r
       ADD_FAILURE() << where.str() << ": " << problem;
       return counts;
     }
-    const std::string lists = check_result_lists(m, r);
+    const std::string lists = check_result_lists(m, r) + check_new_faces_follow_old(m, r);
     const std::string state = check_state_bounds(m, bounds, shape);
     if (!lists.empty() || !state.empty()) {
       ADD_FAILURE() << where.str() << ": " << lists << state;
@@ -239,36 +249,31 @@ Counts run_random_edits(Shape shape, unsigned seed, int steps, double fracture_r
   return counts;
 }
 
-void expect_every_edit_exercised(const Counts& c, int minimum) {
+// Each run checks at least `minimum` successful edits of every kind (and some refusals).
+void run_and_expect(Shape shape, unsigned seed, int steps, double fracture_rate) {
+  const Counts c = run_random_edits(shape, seed, steps, fracture_rate);
+  const int minimum = steps / 25;
   EXPECT_GE(c.split, minimum);
   EXPECT_GE(c.flip, minimum);
   EXPECT_GE(c.collapse, minimum);
   EXPECT_GT(c.refused, 0);
-}
-
-TEST(RandomEdits, FlatSheet) {
-  for (unsigned seed : {1u, 2u}) {
-    const Counts c = run_random_edits(Shape::kFlat, seed, 2500, 0.0);
-    expect_every_edit_exercised(c, 200);
+  if (fracture_rate > 0) {
+    EXPECT_GE(c.node_split, fracture_rate * steps / 3);
   }
 }
 
-TEST(RandomEdits, FlatSheetWithFracture) {
-  const Counts c = run_random_edits(Shape::kFlat, 3, 2500, 0.02);
-  expect_every_edit_exercised(c, 100);
-  EXPECT_GE(c.node_split, 20);
-}
+TEST(RandomEdits, FlatSheet) { run_and_expect(Shape::kFlat, 1, 1200, 0.0); }
+TEST(RandomEdits, FlatSheetWithFracture) { run_and_expect(Shape::kFlat, 3, 1200, 0.02); }
+TEST(RandomEdits, CurvedCylinderRestShape) { run_and_expect(Shape::kCylinder, 4, 1200, 0.01); }
+TEST(RandomEdits, TubeWithRestSeam) { run_and_expect(Shape::kSeamedTube, 5, 1200, 0.01); }
 
-TEST(RandomEdits, CurvedCylinderRestShape) {
-  const Counts c = run_random_edits(Shape::kCylinder, 4, 2500, 0.01);
-  expect_every_edit_exercised(c, 100);
-  EXPECT_GE(c.node_split, 5);
-}
-
-TEST(RandomEdits, TubeWithRestSeam) {
-  const Counts c = run_random_edits(Shape::kSeamedTube, 5, 2500, 0.01);
-  expect_every_edit_exercised(c, 100);
-  EXPECT_GE(c.node_split, 5);
+// Longer runs over more seeds (optimised build only).
+TEST(RandomEditsSlow, ManySeedsAllShapes) {
+  for (unsigned seed = 100; seed < 103; ++seed) {
+    run_and_expect(Shape::kFlat, seed, 4000, 0.01);
+    run_and_expect(Shape::kCylinder, seed, 4000, 0.01);
+    run_and_expect(Shape::kSeamedTube, seed, 4000, 0.01);
+  }
 }
 
 // Remeshes a sheet at random (no fracture), then cracks it from the middle of its left border, always moving

@@ -371,6 +371,17 @@ TEST(CheckMesh, IgnoresTombstonesButNotLinksToThem) {
   EXPECT_EQ(check_mesh(m), "");
 }
 
+TEST(CheckMesh, LargeMeshIsFast) {
+  // 45k faces: a check after each topology phase must stay cheap.
+  Mesh m = make_flat_grid(150, 150);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(check_mesh(m), "");
+  m.faces[44000].Fp(0, 0) = std::nan("");
+  EXPECT_CAUGHT(check_mesh(m), "face 44000");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 20.0);
+}
+
 TEST(CountComponents, CountsPiecesJoinedByEdges) {
   EXPECT_EQ(count_components(make_flat_grid(3, 2)), 1);
   // Two separate triangles.

@@ -1,0 +1,137 @@
+// The pieces of the simulate command that need no binary: JSON lines, output file names, durations.
+#include <gtest/gtest.h>
+#include <json/json.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "app/frame_report.hpp"
+#include "app/json_line.hpp"
+#include "app/output_files.hpp"
+#include "app/progress.hpp"
+
+namespace arcsim {
+namespace {
+
+Json::Value parse(const std::string& text) {
+  Json::CharReaderBuilder builder;
+  Json::Value root;
+  std::string errors;
+  std::istringstream in(text);
+  EXPECT_TRUE(Json::parseFromStream(builder, in, &root, &errors)) << errors << " in " << text;
+  return root;
+}
+
+TEST(JsonNumber, ShortestFormThatReadsBackExactly) {
+  EXPECT_EQ(json_number(0.04), "0.04");
+  EXPECT_EQ(json_number(3), "3");
+  EXPECT_EQ(json_number(-2.5e-7), "-2.5e-07");
+  EXPECT_EQ(json_number(0.1 + 0.2), "0.30000000000000004");
+  const double third = 1.0 / 3;
+  EXPECT_EQ(std::stod(json_number(third)), third);
+  EXPECT_EQ(json_number(std::nan("")), "null");
+  EXPECT_EQ(json_number(-INFINITY), "null");
+}
+
+TEST(FrameLog, LineParsesWithEveryFieldInOrder) {
+  FrameReport r;
+  r.frame = 7;
+  r.time = 0.28;
+  r.steps = 4;
+  r.nodes = 121;
+  r.faces = 200;
+  r.saved = true;
+  r.wall = {0.5, 0.25, 0.125, 0.0625, 0.03125, 0.015625, 1.0};
+  const std::string line = frame_log_line(r);
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  EXPECT_EQ(line.rfind("{\"frame\":7,\"time\":0.28,\"steps\":4,\"nodes\":121,\"faces\":200,\"saved\":true,\"wall\":{", 0),
+            0u)
+      << line;
+  const Json::Value v = parse(line);
+  EXPECT_EQ(v["wall"]["physics"].asDouble(), 0.5);
+  EXPECT_EQ(v["wall"]["collision"].asDouble(), 0.25);
+  EXPECT_EQ(v["wall"]["remeshing"].asDouble(), 0.125);
+  EXPECT_EQ(v["wall"]["plasticity"].asDouble(), 0.0625);
+  EXPECT_EQ(v["wall"]["fracture"].asDouble(), 0.03125);
+  EXPECT_EQ(v["wall"]["output"].asDouble(), 0.015625);
+  EXPECT_EQ(v["wall"]["total"].asDouble(), 1.0);
+  EXPECT_EQ(v.size(), 7u);
+}
+
+TEST(FrameLog, ProgressLineHasNullTotalWhenUnbounded) {
+  FrameReport r;
+  r.frame = 3;
+  r.time = 0.12;
+  r.faces = 8;
+  r.nodes = 9;
+  r.wall.total = 0.01;
+  EXPECT_EQ(progress_json_line(r, 10), "{\"frame\":3,\"total\":10,\"time\":0.12,\"faces\":8,\"nodes\":9,\"wall\":0.01}");
+  EXPECT_TRUE(parse(progress_json_line(r, INFINITY))["total"].isNull());
+}
+
+TEST(OutputFiles, NamesFollowArcsimNumbering) {
+  EXPECT_EQ(cloth_frame_file_name(0, 0), "00000_00.obj");
+  EXPECT_EQ(cloth_frame_file_name(123, 4), "00123_04.obj");
+  EXPECT_EQ(cloth_frame_file_name(123456, 12), "123456_12.obj");
+  EXPECT_EQ(obstacle_frame_file_name(5, 1), "00005_obs01.obj");
+  EXPECT_EQ(static_obstacle_file_name(2), "obs02.obj");
+  for (const char* ours : {"conf.json", "log.jsonl", "00001_00.obj", "obs00.obj", "00001_obs03.obj"})
+    EXPECT_TRUE(is_output_file_name(ours)) << ours;
+  for (const char* theirs : {"square.obj", "meshes", "conf.json5", "paper.json", "obs", "log.json"})
+    EXPECT_FALSE(is_output_file_name(theirs)) << theirs;
+}
+
+TEST(Progress, DurationsForPeople) {
+  EXPECT_EQ(format_duration(0), "0.0 s");
+  EXPECT_EQ(format_duration(12.34), "12.3 s");
+  EXPECT_EQ(format_duration(245), "4m05s");
+  EXPECT_EQ(format_duration(2 * 3600 + 3 * 60 + 10), "2h03m");
+  EXPECT_EQ(format_duration(NAN), "?");
+}
+
+TEST(Progress, JsonStyleWinsOverQuietAndTerminalDecidesTheRest) {
+  EXPECT_EQ(choose_progress_style(true, true, true), ProgressStyle::kJson);
+  EXPECT_EQ(choose_progress_style(true, false, true), ProgressStyle::kQuiet);
+  EXPECT_EQ(choose_progress_style(false, false, true), ProgressStyle::kLive);
+  EXPECT_EQ(choose_progress_style(false, false, false), ProgressStyle::kLines);
+}
+
+TEST(Progress, LiveLineIsRewrittenInPlaceAndEndedOnce) {
+  std::ostringstream out, err;
+  const Console console{out, err, true};
+  Progress progress(ProgressStyle::kLive, console, 4);
+  FrameReport r;
+  r.faces = 200;
+  r.wall.total = 0.5;
+  for (int f = 1; f <= 2; ++f) {
+    r.frame = f;
+    r.time = 0.04 * f;
+    progress.frame_done(r);
+  }
+  progress.end_line();
+  progress.end_line();  // the second call must not add another newline
+  const std::string text = err.str();
+  EXPECT_EQ(out.str(), "");
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\r'), 2);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);
+  EXPECT_NE(text.find("frame 2/4"), std::string::npos) << text;
+  EXPECT_NE(text.find("ETA 1.0 s"), std::string::npos) << text;  // 0.5 s per frame, 2 frames to go
+}
+
+TEST(Progress, LinesStyleReportsAboutEveryFivePercent) {
+  std::ostringstream out, err;
+  const Console console{out, err, false};
+  Progress progress(ProgressStyle::kLines, console, 100);
+  FrameReport r;
+  for (int f = 1; f <= 100; ++f) {
+    r.frame = f;
+    progress.frame_done(r);
+  }
+  const std::string text = err.str();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 21);  // frame 1, then each 5% up to 100%
+  EXPECT_EQ(text.find('\r'), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arcsim
