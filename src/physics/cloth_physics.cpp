@@ -1,7 +1,8 @@
 #include "physics/cloth_physics.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
+#include <iterator>
 #include <cmath>
 #include <string>
 
@@ -33,6 +34,26 @@ double face_bending_stiffness(const Mesh& mesh, const std::vector<Material>& mat
 Mat2 plastic_stretch_2d(const Face& f) {
   if (f.Fp.isIdentity(0)) return Mat2::Identity();
   return f.rest_frame.transpose() * f.Fp * f.rest_frame;
+}
+
+// (row >= col) pairs without diagonal entries, sorted and unique.
+std::vector<std::pair<int, int>> sorted_node_pairs(std::vector<std::pair<int, int>> pairs) {
+  for (auto& p : pairs)
+    if (p.first < p.second) std::swap(p.first, p.second);
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [](const auto& p) { return p.first == p.second; }),
+              pairs.end());
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+// Builds the block pattern from the element and contact pairs and refreshes the elements' block ids.
+void rebuild_pattern(ElementCache& cache) {
+  std::vector<std::pair<int, int>> pairs = cache.element_pairs;
+  pairs.insert(pairs.end(), cache.contact_pairs.begin(), cache.contact_pairs.end());
+  cache.pattern.build(static_cast<int>(cache.node_mass.size()), std::move(pairs));
+  for (auto& f : cache.faces) f.blocks = element_block_ids<3>(cache.pattern, f.nodes);
+  for (auto& b : cache.bending) b.blocks = element_block_ids<6>(cache.pattern, b.nodes);
 }
 
 }  // namespace
@@ -104,11 +125,33 @@ void build_element_cache(const Mesh& mesh, const std::vector<Material>& material
         if (b.nodes[i] != b.nodes[j]) pairs.emplace_back(b.nodes[i], b.nodes[j]);
   }
 
-  cache.pattern.build(static_cast<int>(mesh.nodes.size()), std::move(pairs));
-  for (auto& f : cache.faces) f.blocks = element_block_ids<3>(cache.pattern, f.nodes);
-  for (auto& b : cache.bending) b.blocks = element_block_ids<6>(cache.pattern, b.nodes);
+  cache.element_pairs = sorted_node_pairs(std::move(pairs));
+  cache.contact_pairs.clear();
   cache.node_mass.resize(mesh.nodes.size());
   for (size_t n = 0; n < mesh.nodes.size(); ++n) cache.node_mass[n] = mesh.nodes[n].mass;
+  rebuild_pattern(cache);
+}
+
+bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts) {
+  std::vector<std::pair<int, int>> needed;
+  for (const ContactTerm& c : contacts)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < a; ++b)
+        if (c.nodes[a] != kNone && c.nodes[b] != kNone && c.nodes[a] != c.nodes[b])
+          needed.emplace_back(c.nodes[a], c.nodes[b]);
+  needed = sorted_node_pairs(std::move(needed));
+  std::vector<std::pair<int, int>> extra;
+  std::set_difference(needed.begin(), needed.end(), cache.element_pairs.begin(), cache.element_pairs.end(),
+                      std::back_inserter(extra));
+  const bool missing = !std::includes(cache.contact_pairs.begin(), cache.contact_pairs.end(), extra.begin(),
+                                      extra.end());
+  // Keeping stale pairs costs little (zero blocks) and avoids re-analysing the matrix every time a contact
+  // ends; shrink once they clearly dominate.
+  const bool bloated = cache.contact_pairs.size() > 2 * extra.size() + 256;
+  if (!missing && !bloated) return false;
+  cache.contact_pairs = std::move(extra);
+  rebuild_pattern(cache);
+  return true;
 }
 
 namespace {
@@ -172,56 +215,99 @@ Eigen::Matrix<double, 3 * N, 1> gather_velocity(const Mesh& mesh, const std::arr
   return v;
 }
 
+// Backward Euler terms of one contact: the penalty implicit in position (blocks dt^2 h w_a w_b n n^T, force
+// evaluated at x + dt v) and friction implicit in velocity (blocks dt c w_a w_b P).
+void assemble_contact(const Mesh& mesh, const ContactTerm& c, double dt, BlockSystem& system) {
+  const BlockPattern& pattern = *system.pattern;
+  Vec3 u = c.outside_velocity;
+  for (int i = 0; i < 4; ++i)
+    if (c.nodes[i] != kNone) u += c.weights[i] * mesh.nodes[c.nodes[i]].v;
+  const Mat3 nn = c.normal * c.normal.transpose();
+  const Mat3 tangent = Mat3::Identity() - nn;
+  const Mat3 K = dt * dt * c.stiffness * nn + dt * c.friction_damping * tangent;
+  const Vec3 force = c.force * c.normal - dt * c.stiffness * c.normal.dot(u) * c.normal -
+                     c.friction_damping * (tangent * u);
+  for (int a = 0; a < 4; ++a) {
+    const int na = c.nodes[a];
+    if (na == kNone) continue;
+    system.rhs.segment<3>(3 * na) += dt * c.weights[a] * force;
+    for (int b = 0; b < 4; ++b) {
+      const int nb = c.nodes[b];
+      if (nb == kNone || nb > na) continue;  // lower blocks only
+      if (nb == na && b != a) continue;     // a node listed twice: its own term once per listing
+      const int block = pattern.block_index(na, nb);
+      system.blocks[block] += c.weights[a] * c.weights[b] * K;
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Elements are evaluated in parallel a chunk at a time into a reused buffer, then scattered serially in element
+// order: the sums are the same whatever the thread count (bit-identical results), and memory stays bounded
+// (a whole-mesh buffer of 18x18 matrices would be ~170 MB at 64k faces, touched afresh every step). Chunks are
+// large because every parallel region ends in a barrier, which is costly when the cores are shared.
+constexpr int kAssemblyChunk = 8192;
+
+template <int N, typename Element, typename Evaluate>
+double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements, const InternalAssembly& how,
+                         Evaluate evaluate, BlockSystem& system) {
+  const int count = static_cast<int>(elements.size());
+  const bool need_velocity = how.velocity_scale != 0 || how.damping_velocity_scale != 0;
+  std::vector<ElementResult<N>> results(std::min(count, kAssemblyChunk));
+  double energy = 0;
+  for (int begin = 0; begin < count; begin += kAssemblyChunk) {
+    const int end = std::min(count, begin + kAssemblyChunk);
+#pragma omp parallel for schedule(static)
+    for (int i = begin; i < end; ++i) {
+      const Element& el = elements[i];
+      double element_energy;
+      Eigen::Matrix<double, 3 * N, 1> gradient;
+      Eigen::Matrix<double, 3 * N, 3 * N> hessian;
+      evaluate(el, element_energy, gradient, hessian);
+      ElementResult<N>& r = results[i - begin];
+      r.energy = element_energy;
+      r.K = (how.stiffness_scale + how.damping_scale * el.damping) * hessian;
+      r.rhs = -how.force_scale * gradient;
+      if (need_velocity)
+        r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
+                 (hessian * gather_velocity<N>(mesh, el.nodes));
+    }
+    for (int i = begin; i < end; ++i) {
+      energy += results[i - begin].energy;
+      scatter<N>(elements[i].nodes, elements[i].blocks, results[i - begin], system);
+    }
+  }
+  return energy;
+}
+
 }  // namespace
 
 double assemble_internal(const Mesh& mesh, const ElementCache& cache, const InternalAssembly& how,
                          BlockSystem& system) {
-  const int nf = static_cast<int>(cache.faces.size());
-  const int nb = static_cast<int>(cache.bending.size());
-  std::vector<ElementResult<3>> face_results(nf);
-  std::vector<ElementResult<6>> bending_results(nb);
-  const bool need_velocity = how.velocity_scale != 0 || how.damping_velocity_scale != 0;
-
-#pragma omp parallel
-  {
-#pragma omp for schedule(static) nowait
-    for (int i = 0; i < nf; ++i) {
-      const auto& el = cache.faces[i];
-      const MembraneTerms t =
-          membrane_terms(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x, mesh.nodes[el.nodes[2]].x,
-                         el.Dm_inv, el.area, el.k, 1.0, HessianKind::kProjected);
-      auto& r = face_results[i];
-      r.energy = t.energy;
-      r.K = (how.stiffness_scale + how.damping_scale * el.damping) * t.hessian;
-      r.rhs = -how.force_scale * t.gradient;
-      if (need_velocity)
-        r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 (t.hessian * gather_velocity<3>(mesh, el.nodes));
-    }
-#pragma omp for schedule(static)
-    for (int i = 0; i < nb; ++i) {
-      const auto& el = cache.bending[i];
-      const PlateBendingTerms t = plate_bending_terms(gather_positions(mesh, el.nodes), el.has_wing,
-                                                      el.rest_theta, el.Q, HessianKind::kProjected);
-      auto& r = bending_results[i];
-      r.energy = t.energy;
-      r.K = (how.stiffness_scale + how.damping_scale * el.damping) * t.hessian;
-      r.rhs = -how.force_scale * t.gradient;
-      if (need_velocity)
-        r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 (t.hessian * gather_velocity<6>(mesh, el.nodes));
-    }
-  }
-
-  double energy = 0;
-  for (int i = 0; i < nf; ++i) {
-    energy += face_results[i].energy;
-    scatter<3>(cache.faces[i].nodes, cache.faces[i].blocks, face_results[i], system);
-  }
-  for (int i = 0; i < nb; ++i) {
-    energy += bending_results[i].energy;
-    scatter<6>(cache.bending[i].nodes, cache.bending[i].blocks, bending_results[i], system);
-  }
+  double energy = assemble_elements<3>(
+      mesh, cache.faces, how,
+      [&](const ElementCache::FaceElement& el, double& e, Vec9& g, Mat9& H) {
+        const MembraneTerms t =
+            membrane_terms(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x, mesh.nodes[el.nodes[2]].x,
+                           el.Dm_inv, el.area, el.k, 1.0, HessianKind::kProjected);
+        e = t.energy;
+        g = t.gradient;
+        H = t.hessian;
+      },
+      system);
+  energy += assemble_elements<6>(
+      mesh, cache.bending, how,
+      [&](const ElementCache::BendingElement& el, double& e, Vec18& g, Mat18& H) {
+        const PlateBendingTerms t = plate_bending_terms(gather_positions(mesh, el.nodes), el.has_wing,
+                                                        el.rest_theta, el.Q, HessianKind::kProjected);
+        e = t.energy;
+        g = t.gradient;
+        H = t.hessian;
+      },
+      system);
   return energy;
 }
 
@@ -264,6 +350,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
       for (int i = 0; i < 3; ++i) system.rhs.segment<3>(3 * el.nodes[i]) += dt * w.force.segment<3>(3 * i);
     }
   }
+  for (const ContactTerm& c : loads.contacts) assemble_contact(mesh, c, dt, system);
   if (!loads.pinned.empty()) {
     // Dirichlet: zero the pinned rows and columns, unit diagonal, zero right-hand side (dv = 0).
     for (int k = 0; k < cache.pattern.block_count(); ++k) {

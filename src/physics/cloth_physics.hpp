@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "mesh/mesh.hpp"
@@ -37,6 +38,24 @@ struct ElementCache {
   std::vector<BendingElement> bending;
   BlockPattern pattern;
   std::vector<double> node_mass;  // kg
+  // Node pairs of the pattern: those of the elements, and extra ones for contacts (update_contact_pattern).
+  std::vector<std::pair<int, int>> element_pairs;  // (row >= col), sorted, unique
+  std::vector<std::pair<int, int>> contact_pairs;  // extra pairs not among element_pairs, sorted, unique
+};
+
+// A contact (proximity) term over up to four nodes, linearised for the implicit step. The gap
+// g = n . sum_i w_i x_i feels a penalty force `force` (N, along +n) of stiffness `stiffness` (N/m), and the
+// relative velocity u = sum_i w_i v_i a tangential friction damper -friction_damping (I - n n^T) u (N).
+// Nodes of other meshes (kNone here) only contribute their velocity, through outside_velocity = sum of w_i v_i
+// over them (m/s); they are held fixed in this cloth's solve.
+struct ContactTerm {
+  std::array<int, 4> nodes{kNone, kNone, kNone, kNone};  // node indices of this cloth
+  std::array<double, 4> weights{0, 0, 0, 0};
+  Vec3 normal = Vec3::UnitY();
+  double force = 0;             // N
+  double stiffness = 0;         // N/m
+  double friction_damping = 0;  // kg/s
+  Vec3 outside_velocity = Vec3::Zero();
 };
 
 // Recomputes node masses (kg) from face area densities.
@@ -44,6 +63,11 @@ void update_node_masses(Mesh& mesh, const std::vector<Material>& materials);
 
 // Builds the element cache (and the block pattern) for the mesh's current topology and rest state.
 void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache);
+
+// Makes the pattern contain every node pair coupled by `contacts`. The pattern (and with it the CHOLMOD
+// symbolic analysis) is rebuilt only when a needed pair is missing, or when far more contact pairs are kept
+// than needed. Returns true if it was rebuilt.
+bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts);
 
 // Total elastic energy (J) of the cloth at its current world positions.
 double internal_energy(const Mesh& mesh, const ElementCache& cache);
@@ -76,6 +100,7 @@ struct ExternalLoads {
   WindSpec wind;
   std::vector<HandleSpring> springs;
   std::vector<char> pinned;  // optional, per node: velocity held fixed (Dirichlet)
+  std::vector<ContactTerm> contacts;  // their pairs must be in the pattern (update_contact_pattern)
 };
 
 struct StepTiming {
