@@ -57,5 +57,3 @@ BENCHMARK(BM_ImplicitStep)->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(b
 
 }  // namespace
 }  // namespace arcsim
-
-BENCHMARK_MAIN();
