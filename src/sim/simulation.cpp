@@ -6,6 +6,7 @@
 
 #include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "remesh/remesh_cloth.hpp"
 
 namespace arcsim {
 
@@ -37,6 +38,15 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   for (size_t i = 0; i < scene.cloths.size(); ++i) load_cloth(scene.cloths[i], static_cast<int>(i));
   for (size_t i = 0; i < scene.obstacles.size(); ++i) load_obstacle(scene.obstacles[i], static_cast<int>(i));
   for (size_t i = 0; i < scene.handles.size(); ++i) load_handle(scene.handles[i], static_cast<int>(i));
+  // ARCSim's fixed_high_res_mesh: one uniform refinement to size_min (after the handles marked their nodes
+  // preserved), then no remeshing.
+  if (scene_.enabled("remeshing") && scene_.magic.fixed_high_res_mesh) {
+    const RemeshOptions options = remesh_options(scene_);
+    for (size_t c = 0; c < cloths.size(); ++c) {
+      refine_to_size_min(cloths[c], options);
+      compact_cloth(static_cast<int>(c));
+    }
+  }
   move_obstacles(0);
   for (Obstacle& o : obstacles)
     for (Node& n : o.mesh.nodes) n.v.setZero();
@@ -277,7 +287,31 @@ void Simulation::advance_step() {
   times.collision += seconds_since(t0);
   check_state();
 
-  if (step_ % frame_steps_ == 0) ++frame_;
+  if (step_ % frame_steps_ == 0) {
+    t0 = std::chrono::steady_clock::now();
+    remeshing_step();
+    times.remeshing += seconds_since(t0);
+    ++frame_;
+  }
+}
+
+void Simulation::remeshing_step() {
+  if (!scene_.enabled("remeshing") || scene_.magic.fixed_high_res_mesh) return;
+  const RemeshOptions options = remesh_options(scene_);
+  remesh_stats.assign(cloths.size(), RemeshStats());
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    remesh_stats[c] = remesh(cloths[c], nullptr, options);
+    remesh_stats[c].active_faces.clear();
+    compact_cloth(static_cast<int>(c));
+  }
+  check_state();
+}
+
+void Simulation::compact_cloth(int c) {
+  Cloth& cloth = cloths[c];
+  if (cloth.mesh.is_compact()) return;
+  remap_handles(handles, c, cloth.mesh.compact());
+  cloth.elements_dirty = true;
 }
 
 void Simulation::advance_frame() {

@@ -11,6 +11,7 @@
 #include "collision/collision_step.hpp"
 #include "mesh/mesh.hpp"
 #include "physics/cloth_physics.hpp"
+#include "remesh/remesh.hpp"
 #include "restshape/reference_surface.hpp"
 #include "scene/scene.hpp"
 
@@ -84,6 +85,12 @@ class Simulation {
   std::vector<Obstacle> obstacles;
   std::vector<Handle> handles;
   ModuleTimes times;
+  // Per cloth, the operation counts of the last frame-end remeshing pass (active_faces left empty). Mesh sizes
+  // for the log: remesh/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
+  std::vector<RemeshStats> remesh_stats;
+
+  // After topology edits of cloth c: drops the dead elements and remaps the handles' node indices.
+  void compact_cloth(int c);
 
   // Overrides of the scene's end (command-line options); infinity keeps the scene's value.
   void set_end_time(double t) { end_time_ = t; }
@@ -105,6 +112,8 @@ class Simulation {
   std::vector<std::vector<ContactTerm>> proximity_step(double dt);
   void physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts);
   void collision_step(double dt);
+  // Frame-end remeshing of every cloth (module "remeshing", unless the mesh is fixed), then compaction.
+  void remeshing_step();
   void check_state() const;
 
   Scene scene_;

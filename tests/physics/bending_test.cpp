@@ -329,7 +329,7 @@ double cylinder_energy_ratio(int rows, int cols, double a, double angle, double 
     const Edge& edge = mesh.edges[e];
     if (edge.is_boundary()) continue;
     const double A0 = mesh.faces[edge.f[0]].rest_area, A1 = mesh.faces[edge.f[1]].rest_area;
-    const double l = (mesh.verts[mesh.nodes[edge.n[0]].verts[0]].u - mesh.verts[mesh.nodes[edge.n[1]].verts[0]].u).norm();
+    const double l = (u[edge.n[0]] - u[edge.n[1]]).norm();  // vert k is node k here
     EXPECT_NEAR(l, a, 1e-12 * a);
     EXPECT_EQ(edge.rest_theta, 0);
     energy += hinge_energy(mesh.nodes[edge.n[0]].x, mesh.nodes[edge.n[1]].x,
@@ -339,6 +339,23 @@ double cylinder_energy_ratio(int rows, int cols, double a, double angle, double 
     area += (A0 + A1) / 3;
   }
   return energy / (0.5 * kb * area / (R * R));
+}
+
+TEST(HingeBending, CylinderDihedralAngleOfEquilateralPair) {
+  // The relation hinge_weight's comment relies on: theta = h (kappa_nn - kappa_tt / 3) for an equilateral pair
+  // (height h) whose edge normal n makes angle psi with the curvature direction.
+  const double R = 2, a = 0.01, h = a * std::sqrt(3.0) / 2;
+  auto on_cylinder = [R](const Vec2& p) {
+    return Vec3(R * std::sin(p.x() / R), p.y(), R * (1 - std::cos(p.x() / R)));
+  };
+  for (double psi : {0.0, 0.4, 1.0, M_PI / 3, 1.3, M_PI / 2}) {
+    const Vec2 n(std::cos(psi), std::sin(psi)), t(-std::sin(psi), std::cos(psi));
+    const Vec2 p0 = Vec2(0.1, 0.2) - 0.5 * a * t, p1 = Vec2(0.1, 0.2) + 0.5 * a * t;
+    const double theta = dihedral_angle(on_cylinder(p0), on_cylinder(p1), on_cylinder(Vec2(0.1, 0.2) - h * n),
+                                        on_cylinder(Vec2(0.1, 0.2) + h * n));
+    const double c2 = n.x() * n.x(), s2 = t.x() * t.x();
+    EXPECT_NEAR(std::fabs(theta), h / R * std::fabs(c2 - s2 / 3), 1e-3 * h / R) << "psi " << psi;
+  }
 }
 
 TEST(HingeBending, CylinderMatchesContinuumPlateEnergy) {

@@ -1,0 +1,48 @@
+// The two collision phases of a time step, over all cloths and obstacles:
+//  - before the velocity solve, proximity (repulsion + friction) terms for each cloth's implicit system;
+//  - after the position update, the impact-zone response that makes the step's motion collision free.
+// A CollisionHandler keeps the per-mesh BVHs between steps (rebuilt only when a topology changes).
+#pragma once
+
+#include <vector>
+
+#include "collision/candidates.hpp"
+#include "collision/impact_zones.hpp"
+#include "collision/proximity.hpp"
+#include "mesh/mesh.hpp"
+#include "physics/cloth_physics.hpp"
+
+namespace arcsim {
+
+struct CollisionSettings {
+  double repulsion_thickness = 1e-3;   // m
+  double projection_thickness = 1e-4;  // m
+  double stiffness = 1e9;              // collision_stiffness (N/m^3, times element area)
+  double friction = 0.6;               // cloth-cloth
+  double obstacle_friction = 0.3;      // cloth-obstacle and floor
+  bool floor = false;                  // floor proxy
+  double floor_height = 0;             // m
+  int step = 0;                        // for messages
+};
+
+class CollisionHandler {
+ public:
+  // Contact terms for each cloth (in the order given) at the start of the step: cloths at x moving with v,
+  // obstacles at x0 moving to x in dt (s).
+  std::vector<std::vector<ContactTerm>> proximity_terms(const std::vector<const Mesh*>& cloths,
+                                                        const std::vector<const Mesh*>& obstacles,
+                                                        const CollisionSettings& settings, double dt);
+
+  // After the position update (every node moved x0 -> x): moves cloth nodes so that the motion is collision
+  // free and adds the position change / dt to their velocities.
+  ImpactZoneStats resolve_collisions(const std::vector<Mesh*>& cloths, const std::vector<const Mesh*>& obstacles,
+                                     const CollisionSettings& settings, double dt);
+
+  const BvhCache& bvh_cache() const { return cache_; }
+
+ private:
+  BvhCache cache_;
+  ContactGeometry geometry_;
+};
+
+}  // namespace arcsim

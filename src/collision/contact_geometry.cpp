@@ -1,0 +1,133 @@
+#include "collision/contact_geometry.hpp"
+
+namespace arcsim {
+
+namespace {
+
+uint64_t mix(uint64_t h, uint64_t value) {
+  // FNV-1a style accumulation; only equality of whole topologies matters.
+  h ^= value + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+  return h * 0x100000001b3ULL;
+}
+
+void append_mesh(const ContactBody& body, ContactStage stage, double dt, ContactGeometry& g) {
+  const Mesh& mesh = *body.mesh;
+  ContactGeometry::Range r;
+  r.deformable = body.deformable;
+  r.node_begin = g.node_count();
+  r.edge_begin = static_cast<int>(g.edges.size());
+  r.face_begin = static_cast<int>(g.faces.size());
+  const int mesh_index = static_cast<int>(g.meshes.size());
+
+  for (const Node& n : mesh.nodes) {
+    Vec3 start = n.x0, end = n.x, velocity = n.v;
+    if (!body.deformable) {
+      velocity = dt > 0 ? Vec3((n.x - n.x0) / dt) : Vec3::Zero();
+    } else if (stage == ContactStage::kBeforeStep) {
+      start = n.x;
+      end = n.x + dt * n.v;
+    }
+    g.x0.push_back(start);
+    g.x1.push_back(end);
+    g.v.push_back(velocity);
+    g.mass.push_back(body.deformable && n.mass > 0 ? n.mass : kInfinity);
+    g.area.push_back(0);
+    g.node_mesh.push_back(mesh_index);
+  }
+  uint64_t topology = mix(mesh.nodes.size(), mesh.faces.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Face& face = mesh.faces[f];
+    std::array<int, 3> nodes{kNone, kNone, kNone};
+    if (!face.dead)
+      for (int i = 0; i < 3; ++i) nodes[i] = r.node_begin + mesh.face_node(static_cast<int>(f), i);
+    g.faces.push_back(nodes);
+    for (int i = 0; i < 3; ++i) topology = mix(topology, static_cast<uint64_t>(nodes[i] - r.node_begin));
+    double area = 0;
+    if (!face.dead) {
+      area = body.deformable ? face.rest_area
+                             : 0.5 * (g.x0[nodes[1]] - g.x0[nodes[0]]).cross(g.x0[nodes[2]] - g.x0[nodes[0]]).norm();
+      for (int i = 0; i < 3; ++i) g.area[nodes[i]] += area / 3;
+    }
+    g.face_area.push_back(area);
+  }
+  for (const Edge& e : mesh.edges) {
+    if (e.dead) {
+      g.edges.push_back({kNone, kNone});
+      g.edge_faces.push_back({kNone, kNone});
+      continue;
+    }
+    g.edges.push_back({r.node_begin + e.n[0], r.node_begin + e.n[1]});
+    g.edge_faces.push_back({e.f[0] == kNone ? kNone : r.face_begin + e.f[0],
+                            e.f[1] == kNone ? kNone : r.face_begin + e.f[1]});
+  }
+  r.node_end = g.node_count();
+  r.edge_end = static_cast<int>(g.edges.size());
+  r.face_end = static_cast<int>(g.faces.size());
+  r.topology = topology;
+  g.meshes.push_back(r);
+
+  // Ownership: the first live face incident to each node and edge.
+  std::vector<int> node_owner(mesh.nodes.size(), kNone);
+  for (int f = r.face_begin; f < r.face_end; ++f)
+    for (int n : g.faces[f])
+      if (n != kNone && node_owner[n - r.node_begin] == kNone) node_owner[n - r.node_begin] = f;
+  std::vector<std::vector<int>> nodes_of(r.face_end - r.face_begin), edges_of(r.face_end - r.face_begin);
+  for (size_t n = 0; n < node_owner.size(); ++n)
+    if (node_owner[n] != kNone) nodes_of[node_owner[n] - r.face_begin].push_back(r.node_begin + static_cast<int>(n));
+  for (int e = r.edge_begin; e < r.edge_end; ++e) {
+    const auto& ef = g.edge_faces[e];
+    int owner = kNone;
+    for (int f : ef)
+      if (f != kNone && (owner == kNone || f < owner)) owner = f;
+    if (owner != kNone) edges_of[owner - r.face_begin].push_back(e);
+  }
+  for (int f = 0; f < r.face_end - r.face_begin; ++f) {
+    g.owned_node_begin.push_back(static_cast<int>(g.owned_nodes.size()));
+    g.owned_nodes.insert(g.owned_nodes.end(), nodes_of[f].begin(), nodes_of[f].end());
+    g.owned_edge_begin.push_back(static_cast<int>(g.owned_edges.size()));
+    g.owned_edges.insert(g.owned_edges.end(), edges_of[f].begin(), edges_of[f].end());
+  }
+}
+
+}  // namespace
+
+void build_contact_geometry(const std::vector<ContactBody>& bodies, ContactStage stage, double dt,
+                            ContactGeometry& g) {
+  g = ContactGeometry();
+  for (const ContactBody& body : bodies) append_mesh(body, stage, dt, g);
+  g.owned_node_begin.push_back(static_cast<int>(g.owned_nodes.size()));
+  g.owned_edge_begin.push_back(static_cast<int>(g.owned_edges.size()));
+}
+
+std::vector<Vec3> face_normals(const ContactGeometry& g, const std::vector<Vec3>& x) {
+  std::vector<Vec3> n(g.faces.size(), Vec3::Zero());
+  for (size_t f = 0; f < g.faces.size(); ++f) {
+    const auto& v = g.faces[f];
+    if (v[0] == kNone) continue;
+    const Vec3 c = (x[v[1]] - x[v[0]]).cross(x[v[2]] - x[v[0]]);
+    if (c.squaredNorm() > 0) n[f] = c.normalized();
+  }
+  return n;
+}
+
+std::vector<Vec3> node_normals(const ContactGeometry& g, const std::vector<Vec3>& face_normal) {
+  std::vector<Vec3> n(g.node_count(), Vec3::Zero());
+  for (size_t f = 0; f < g.faces.size(); ++f)
+    if (g.faces[f][0] != kNone)
+      for (int v : g.faces[f]) n[v] += face_normal[f];
+  for (Vec3& d : n)
+    if (d.squaredNorm() > 0) d.normalize();
+  return n;
+}
+
+std::vector<Vec3> edge_normals(const ContactGeometry& g, const std::vector<Vec3>& face_normal) {
+  std::vector<Vec3> n(g.edges.size(), Vec3::Zero());
+  for (size_t e = 0; e < g.edges.size(); ++e) {
+    for (int f : g.edge_faces[e])
+      if (f != kNone) n[e] += face_normal[f];
+    if (n[e].squaredNorm() > 0) n[e].normalize();
+  }
+  return n;
+}
+
+}  // namespace arcsim

@@ -1,0 +1,277 @@
+#include "collision/impact_zones.hpp"
+
+#include <algorithm>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+namespace arcsim {
+
+std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache,
+                                         const ImpactZoneParams& params) {
+  CandidateOptions options;
+  options.margin = params.contact_distance;
+  options.swept = true;
+  const std::vector<PrimitivePair> pairs = find_candidates(g, cache, options);
+  CcdOptions ccd;
+  ccd.contact_distance = params.contact_distance;
+
+  std::vector<std::optional<ImpactRecord>> found(pairs.size());
+#pragma omp parallel for schedule(dynamic, 64) if (pairs.size() > 1024)
+  for (int k = 0; k < static_cast<int>(pairs.size()); ++k) {
+    const PrimitivePair& p = pairs[k];
+    const std::array<int, 4> nodes = pair_nodes(g, p);
+    std::array<Vec3, 4> x0, x1;
+    for (int i = 0; i < 4; ++i) {
+      x0[i] = g.x0[nodes[i]];
+      x1[i] = g.x1[nodes[i]];
+    }
+    const std::optional<Impact> hit = p.kind == PairKind::kVertexFace ? vertex_face_impact(x0, x1, ccd)
+                                                                      : edge_edge_impact(x0, x1, ccd);
+    if (!hit) continue;
+    ImpactRecord r;
+    r.kind = static_cast<int>(p.kind);
+    r.a = p.a;
+    r.b = p.b;
+    r.nodes = nodes;
+    r.weights = hit->contact.weights;
+    r.normal = hit->contact.normal;
+    r.time = hit->time;
+    found[k] = r;
+  }
+  std::vector<ImpactRecord> impacts;
+  for (const auto& f : found)
+    if (f) impacts.push_back(*f);
+
+  if (params.floor) {
+    // The floor proxy is a plane under everything: a node that was above it may not end below it.
+    for (const auto& r : g.meshes) {
+      if (!r.deformable) continue;
+      for (int n = r.node_begin; n < r.node_end; ++n) {
+        const double h0 = g.x0[n].y() - params.floor_height, h1 = g.x1[n].y() - params.floor_height;
+        if (!(h0 >= -params.contact_distance) || !(h1 < params.contact_distance)) continue;
+        ImpactRecord rec;
+        rec.kind = kFloorImpact;
+        rec.a = rec.b = n;
+        rec.nodes = {n, kNone, kNone, kNone};
+        rec.weights = {1, 0, 0, 0};
+        rec.normal = Vec3::UnitY();
+        rec.offset = -params.floor_height;
+        rec.time = h0 > h1 ? std::clamp(h0 / (h0 - h1), 0.0, 1.0) : 0.0;
+        impacts.push_back(rec);
+      }
+    }
+  }
+  return impacts;
+}
+
+namespace {
+
+enum class ZoneState { kProjected, kRigid, kFrozen };
+
+struct Zone {
+  std::vector<int> nodes;  // global, movable
+  std::vector<ImpactRecord> constraints;
+  ZoneState state = ZoneState::kProjected;
+  bool alive = true;
+  bool dirty = false;
+  bool warned = false;
+};
+
+class ZoneSet {
+ public:
+  explicit ZoneSet(const ContactGeometry& g) : g_(g), zone_of_(g.node_count(), kNone) {}
+
+  // Adds the impacts' constraints, creating and merging zones over shared movable nodes.
+  void add(const std::vector<ImpactRecord>& impacts) {
+    for (const ImpactRecord& r : impacts) {
+      std::vector<int> movable;
+      for (int i = 0; i < 4; ++i)
+        if (r.nodes[i] != kNone && r.weights[i] != 0 && g_.movable(r.nodes[i])) movable.push_back(r.nodes[i]);
+      if (movable.empty()) continue;
+      int target = kNone;
+      for (int n : movable)
+        if (zone_of_[n] != kNone && (target == kNone || zone_of_[n] < target)) target = zone_of_[n];
+      if (target == kNone) {
+        target = static_cast<int>(zones_.size());
+        zones_.emplace_back();
+      }
+      for (int n : movable) {
+        const int z = zone_of_[n];
+        if (z == target) continue;
+        if (z == kNone) {
+          zone_of_[n] = target;
+          zones_[target].nodes.push_back(n);
+        } else {
+          absorb(target, z);
+        }
+      }
+      add_constraint(zones_[target], r);
+      zones_[target].dirty = true;
+    }
+  }
+
+  std::vector<Zone>& zones() { return zones_; }
+
+ private:
+  void absorb(int target, int source) {
+    Zone& t = zones_[target];
+    Zone& s = zones_[source];
+    for (int n : s.nodes) zone_of_[n] = target;
+    t.nodes.insert(t.nodes.end(), s.nodes.begin(), s.nodes.end());
+    for (const ImpactRecord& r : s.constraints) add_constraint(t, r);
+    t.state = std::max(t.state, s.state);
+    s = Zone();
+    s.alive = false;
+  }
+
+  static void add_constraint(Zone& zone, const ImpactRecord& r) {
+    // A pair detected again with (almost) the same normal refreshes its constraint; a different normal is
+    // kept as an additional constraint (the pair's relative orientation changed during the step).
+    for (ImpactRecord& c : zone.constraints) {
+      if (c.kind == r.kind && c.a == r.a && c.b == r.b && c.normal.dot(r.normal) > 0.999) {
+        c = r;
+        return;
+      }
+    }
+    zone.constraints.push_back(r);
+  }
+
+  const ContactGeometry& g_;
+  std::vector<int> zone_of_;
+  std::vector<Zone> zones_;
+};
+
+ZoneResult project_zone(Zone& zone, const std::vector<Vec3>& target, ContactGeometry& g,
+                        const ImpactZoneParams& params) {
+  std::sort(zone.nodes.begin(), zone.nodes.end());
+  auto local = [&](int node) {
+    return static_cast<int>(std::lower_bound(zone.nodes.begin(), zone.nodes.end(), node) - zone.nodes.begin());
+  };
+  ZoneProblem problem;
+  problem.thickness = params.thickness;
+  std::vector<Vec3> x;
+  for (int n : zone.nodes) {
+    problem.target.push_back(target[n]);
+    problem.mass.push_back(g.mass[n]);
+    x.push_back(g.x1[n]);
+  }
+  for (const ImpactRecord& r : zone.constraints) {
+    ZoneConstraint c;
+    c.normal = r.normal;
+    c.fixed_offset = r.offset;
+    for (int i = 0; i < 4; ++i) {
+      const int n = r.nodes[i];
+      if (n == kNone || r.weights[i] == 0) continue;
+      if (g.movable(n)) {
+        c.vars[i] = local(n);
+        c.weights[i] = r.weights[i];
+      } else {
+        c.fixed_offset += r.weights[i] * r.normal.dot(g.x1[n]);
+      }
+    }
+    problem.constraints.push_back(c);
+  }
+  const ZoneResult result = solve_impact_zone(problem, x, params.method);
+  for (size_t i = 0; i < zone.nodes.size(); ++i) g.x1[zone.nodes[i]] = x[i];
+  return result;
+}
+
+// Rigid fallback: the zone keeps its mean (mass-weighted) displacement of the step, or stays at x0.
+void move_rigidly(const Zone& zone, const std::vector<Vec3>& target, ContactGeometry& g) {
+  Vec3 displacement = Vec3::Zero();
+  if (zone.state == ZoneState::kRigid) {
+    double mass = 0;
+    for (int n : zone.nodes) {
+      displacement += g.mass[n] * (target[n] - g.x0[n]);
+      mass += g.mass[n];
+    }
+    displacement /= mass;
+  }
+  for (int n : zone.nodes) g.x1[n] = g.x0[n] + displacement;
+}
+
+void warn(const ImpactZoneParams& params, const std::string& what) {
+  std::ostringstream msg;
+  msg << "warning: collision: step " << params.step << ": " << what << "\n";
+  std::cerr << msg.str();
+}
+
+}  // namespace
+
+ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params) {
+  ImpactZoneStats stats;
+  const std::vector<Vec3> target = g.x1;
+  ZoneSet zones(g);
+  auto finish = [&](bool resolved) {
+    stats.resolved = resolved;
+    for (const Zone& z : zones.zones()) {
+      if (!z.alive || z.nodes.empty()) continue;
+      ++stats.zones;
+      stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(z.nodes.size()));
+      if (z.state != ZoneState::kProjected) ++stats.fallback_zones;
+    }
+    return stats;
+  };
+
+  // Projection rounds.
+  for (int iteration = 0; iteration <= params.max_iterations; ++iteration) {
+    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params);
+    stats.iterations = iteration + 1;
+    if (iteration == 0) stats.impacts = static_cast<int>(impacts.size());
+    if (impacts.empty()) return finish(true);
+    if (iteration == params.max_iterations) {
+      zones.add(impacts);
+      break;
+    }
+    zones.add(impacts);
+    std::vector<Zone*> dirty;
+    size_t zone_nodes = 0;
+    for (Zone& z : zones.zones()) {
+      if (!z.alive || !z.dirty) continue;
+      dirty.push_back(&z);
+      zone_nodes += z.nodes.size();
+    }
+#pragma omp parallel for schedule(dynamic, 1) if (dirty.size() > 1 && zone_nodes > 64)
+    for (int k = 0; k < static_cast<int>(dirty.size()); ++k) {
+      project_zone(*dirty[k], target, g, params);
+      dirty[k]->dirty = false;
+    }
+  }
+
+  // Fallback rounds: zones still colliding move rigidly, then (if that collides too) stay at x0.
+  for (int round = 0; round < params.max_fallback_iterations; ++round) {
+    bool any = false;
+    for (Zone& z : zones.zones()) {
+      if (!z.alive || !z.dirty) continue;
+      any = true;
+      z.dirty = false;
+      if (z.state == ZoneState::kProjected) {
+        z.state = ZoneState::kRigid;
+        std::ostringstream what;
+        what << "impact zone of " << z.nodes.size() << " nodes unresolved after " << params.max_iterations
+             << " iterations; moving it rigidly";
+        warn(params, what.str());
+      } else if (z.state == ZoneState::kRigid && round > 0) {
+        z.state = ZoneState::kFrozen;
+        std::ostringstream what;
+        what << "rigid impact zone of " << z.nodes.size() << " nodes still collides; holding it at its start "
+             << "position";
+        warn(params, what.str());
+      }
+      move_rigidly(z, target, g);
+    }
+    if (!any) break;
+    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params);
+    ++stats.iterations;
+    if (impacts.empty()) return finish(true);
+    zones.add(impacts);
+  }
+  std::ostringstream what;
+  what << "collisions remain unresolved (zones held at their start positions are hit by moving obstacles "
+       << "or other zones)";
+  warn(params, what.str());
+  return finish(false);
+}
+
+}  // namespace arcsim

@@ -1,0 +1,58 @@
+// Collision response after the position update (Bridson et al. 2002, Harmon et al. 2008, as in ARCSim):
+// continuous collision detection over x0 -> x1 finds impacts; impacts sharing movable nodes are grouped into
+// impact zones, and each zone is projected so that every impact's gap is at least the projection thickness
+// (zone_solver.hpp). Detection and projection repeat, zones growing and keeping their constraints, until the
+// motion is collision free. A zone that does not resolve within the iteration limit falls back to rigid motion
+// of its nodes with their mean displacement (and, if even that collides, to staying at x0), with a warning on
+// stderr: never to silent interpenetration.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "collision/candidates.hpp"
+#include "collision/ccd.hpp"
+#include "collision/contact_geometry.hpp"
+#include "collision/zone_solver.hpp"
+
+namespace arcsim {
+
+struct ImpactZoneParams {
+  double thickness = 1e-4;         // projection thickness: required gap after the projection (m)
+  double contact_distance = 1e-6;  // CCD contact distance (m)
+  int max_iterations = 30;         // detect/project rounds before the rigid fallback
+  int max_fallback_iterations = 20;
+  bool floor = false;              // floor proxy: nodes may not cross the plane y = floor_height downwards
+  double floor_height = 0;         // m
+  ZoneMethod method = ZoneMethod::kAutomatic;
+  int step = 0;                    // for messages
+};
+
+struct ImpactRecord {
+  int kind = 0;                    // PairKind, or kFloorImpact
+  int a = 0, b = 0;                // the primitives (for PairKind) / the node (floor)
+  std::array<int, 4> nodes{kNone, kNone, kNone, kNone};  // global node indices
+  std::array<double, 4> weights{0, 0, 0, 0};
+  Vec3 normal = Vec3::UnitY();
+  double offset = 0;               // constant part of the gap (floor: -floor_height) (m)
+  double time = 0;                 // normalised time of contact
+};
+constexpr int kFloorImpact = 3;
+
+// Every impact of the motion x0 -> x1 of the geometry (at most one per primitive pair: the first), in a
+// deterministic order.
+std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params);
+
+struct ImpactZoneStats {
+  int iterations = 0;        // detection rounds
+  int impacts = 0;           // impacts found in the first round
+  int zones = 0;             // zones at the end
+  int largest_zone = 0;      // nodes
+  int fallback_zones = 0;    // zones moved rigidly or held at x0
+  bool resolved = true;      // the final motion is collision free
+};
+
+// Moves the movable nodes' end positions g.x1 so that the motion is collision free.
+ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params);
+
+}  // namespace arcsim

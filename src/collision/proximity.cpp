@@ -1,0 +1,213 @@
+#include "collision/proximity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "collision/distance.hpp"
+
+namespace arcsim {
+
+Penalty repulsion_penalty(double gap, double k, double thickness) {
+  const double depth = thickness - gap;
+  if (!(depth > 0) || !(thickness > 0)) return {};
+  return {k * depth * depth / (2 * thickness), k * depth / thickness};
+}
+
+double friction_damping(double mu, double normal_force, double tangential_speed, double effective_mass,
+                        double dt) {
+  if (!(mu > 0) || !(normal_force > 0) || !(dt > 0)) return 0;
+  const double cap = kStickFactor * effective_mass / dt;
+  if (!(tangential_speed > 0)) return cap;
+  return std::min(mu * normal_force / tangential_speed, cap);
+}
+
+namespace {
+
+// Which element slot a pair competes for: the nearest partner per (element, side) wins.
+enum SlotKind { kNodeSlot, kEdgeSlot, kFaceSlot, kNodeLipSlot, kEdgeLipSlot };
+
+struct Candidate {
+  ProximityContact contact;
+  double distance = kInfinity;
+  std::array<std::pair<int, int>, 2> slots;  // (kind, 2 * element + side)
+};
+
+class ProximitySearch {
+ public:
+  ProximitySearch(const ContactGeometry& g, const ProximityParams& params)
+      : g_(g), params_(params), face_normal_(face_normals(g, g.x0)) {
+    node_normal_ = node_normals(g, face_normal_);
+    edge_normal_ = edge_normals(g, face_normal_);
+  }
+
+  // The pair as a candidate contact, or distance = infinity if it is not within the thickness.
+  Candidate evaluate(const PrimitivePair& p) const {
+    Candidate c;
+    const std::array<int, 4> nodes = pair_nodes(g_, p);
+    const auto& x = g_.x0;
+    ClosestPoints cp;
+    double area_a = 0, area_b = 0;
+    switch (p.kind) {
+      case PairKind::kVertexFace:
+        cp = vertex_face_closest(x[nodes[0]], x[nodes[1]], x[nodes[2]], x[nodes[3]]);
+        area_a = g_.area[p.a];
+        area_b = g_.face_area[p.b];
+        c.slots = {{{kNodeSlot, side_slot(p.a, -cp.normal.dot(node_normal_[p.a]))},
+                    {kFaceSlot, side_slot(p.b, cp.normal.dot(face_normal_[p.b]))}}};
+        break;
+      case PairKind::kEdgeEdge:
+        cp = edge_edge_closest(x[nodes[0]], x[nodes[1]], x[nodes[2]], x[nodes[3]]);
+        area_a = edge_area(p.a);
+        area_b = edge_area(p.b);
+        c.slots = {{{kEdgeSlot, side_slot(p.a, -cp.normal.dot(edge_normal_[p.a]))},
+                    {kEdgeSlot, side_slot(p.b, cp.normal.dot(edge_normal_[p.b]))}}};
+        break;
+      case PairKind::kVertexEdge:
+        cp = vertex_edge_closest(x[nodes[0]], x[nodes[1]], x[nodes[2]]);
+        if (!outward_of_lip(p.b, nodes[0], cp)) return c;
+        area_a = g_.area[p.a];
+        area_b = edge_area(p.b);
+        c.slots = {{{kNodeLipSlot, 2 * p.a}, {kEdgeLipSlot, 2 * p.b}}};
+        break;
+    }
+    if (!(cp.distance < params_.thickness)) return c;
+    c.distance = cp.distance;
+    c.contact.nodes = nodes;
+    c.contact.weights = cp.weights;
+    c.contact.normal = cp.normal;
+    c.contact.gap = cp.distance;
+    c.contact.stiffness = params_.stiffness * std::min(area_a, area_b);
+    bool immovable = false;
+    for (int n : nodes)
+      if (n != kNone && !g_.movable(n)) immovable = true;
+    c.contact.friction = immovable ? params_.obstacle_friction : params_.friction;
+    return c;
+  }
+
+ private:
+  static int side_slot(int element, double side) { return 2 * element + (side >= 0 ? 1 : 0); }
+
+  double edge_area(int e) const {
+    double a = 0;
+    for (int f : g_.edge_faces[e])
+      if (f != kNone) a += g_.face_area[f] / 3;
+    return a;
+  }
+
+  // The vertex lies in the half-cylinder around boundary edge e on the side away from the edge's face, and
+  // projects inside the edge (the lip of a crack facing the other lip).
+  bool outward_of_lip(int e, int vertex, const ClosestPoints& cp) const {
+    if (cp.weights[1] == 0 || cp.weights[2] == 0) return false;  // projects onto an end point
+    const int f = g_.edge_faces[e][0] != kNone ? g_.edge_faces[e][0] : g_.edge_faces[e][1];
+    if (f == kNone) return false;
+    const auto& x = g_.x0;
+    const int a = g_.edges[e][0], b = g_.edges[e][1];
+    int opposite = kNone;
+    for (int n : g_.faces[f])
+      if (n != a && n != b) opposite = n;
+    Vec3 outward = (x[b] - x[a]).cross(face_normal_[f]);
+    if (outward.dot(x[opposite] - x[a]) > 0) outward = -outward;
+    const Vec3 closest = x[vertex] - cp.distance * cp.normal;
+    return outward.dot(x[vertex] - closest) > 0;
+  }
+
+  const ContactGeometry& g_;
+  const ProximityParams& params_;
+  std::vector<Vec3> face_normal_, node_normal_, edge_normal_;
+};
+
+}  // namespace
+
+std::vector<ProximityContact> find_proximities(const ContactGeometry& g, BvhCache& cache,
+                                               const ProximityParams& params) {
+  CandidateOptions options;
+  options.margin = params.thickness;
+  options.swept = false;
+  options.vertex_edge = true;
+  const std::vector<PrimitivePair> pairs = find_candidates(g, cache, options);
+
+  const ProximitySearch search(g, params);
+  std::vector<Candidate> candidates(pairs.size());
+#pragma omp parallel for schedule(dynamic, 64) if (pairs.size() > 2048)
+  for (int k = 0; k < static_cast<int>(pairs.size()); ++k) candidates[k] = search.evaluate(pairs[k]);
+
+  // Nearest partner per slot; ties go to the earlier pair (deterministic).
+  std::map<std::pair<int, int>, int> best;
+  for (int k = 0; k < static_cast<int>(candidates.size()); ++k) {
+    if (candidates[k].distance == kInfinity) continue;
+    for (const auto& slot : candidates[k].slots) {
+      auto it = best.find(slot);
+      if (it == best.end())
+        best.emplace(slot, k);
+      else if (candidates[k].distance < candidates[it->second].distance)
+        it->second = k;
+    }
+  }
+  std::vector<char> kept(candidates.size(), 0);
+  for (const auto& entry : best) kept[entry.second] = 1;
+
+  std::vector<ProximityContact> contacts;
+  for (size_t k = 0; k < candidates.size(); ++k)
+    if (kept[k]) contacts.push_back(candidates[k].contact);
+
+  if (params.floor) {
+    for (const auto& r : g.meshes) {
+      if (!r.deformable) continue;
+      for (int n = r.node_begin; n < r.node_end; ++n) {
+        const double height = g.x0[n].y() - params.floor_height;
+        if (!(height < params.thickness) || g.area[n] <= 0) continue;
+        ProximityContact c;
+        c.nodes = {n, kNone, kNone, kNone};
+        c.weights = {1, 0, 0, 0};
+        c.normal = Vec3::UnitY();
+        c.gap = height;
+        c.stiffness = params.stiffness * g.area[n];
+        c.friction = params.obstacle_friction;
+        contacts.push_back(c);
+      }
+    }
+  }
+  return contacts;
+}
+
+std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vector<ProximityContact>& contacts,
+                                       int mesh, double thickness, double dt) {
+  const auto& r = g.meshes[mesh];
+  std::vector<ContactTerm> terms;
+  if (!r.deformable) return terms;  // immovable meshes have no implicit system
+  for (const ProximityContact& c : contacts) {
+    bool involved = false;
+    for (int n : c.nodes)
+      if (n != kNone && n >= r.node_begin && n < r.node_end) involved = true;
+    if (!involved) continue;
+    const Penalty p = repulsion_penalty(c.gap, c.stiffness, thickness);
+    if (p.force <= 0 && p.stiffness <= 0) continue;
+
+    ContactTerm t;
+    t.normal = c.normal;
+    t.force = p.force;
+    t.stiffness = p.stiffness;
+    Vec3 relative_velocity = Vec3::Zero();
+    double inverse_mass = 0;
+    for (int i = 0; i < 4; ++i) {
+      const int n = c.nodes[i];
+      if (n == kNone || c.weights[i] == 0) continue;
+      relative_velocity += c.weights[i] * g.v[n];
+      if (g.movable(n)) inverse_mass += c.weights[i] * c.weights[i] / g.mass[n];
+      if (n >= r.node_begin && n < r.node_end) {
+        t.nodes[i] = n - r.node_begin;
+        t.weights[i] = c.weights[i];
+      } else {
+        t.outside_velocity += c.weights[i] * g.v[n];
+      }
+    }
+    const Vec3 tangential = relative_velocity - c.normal * c.normal.dot(relative_velocity);
+    if (inverse_mass > 0)
+      t.friction_damping = friction_damping(c.friction, p.force, tangential.norm(), 1 / inverse_mass, dt);
+    terms.push_back(t);
+  }
+  return terms;
+}
+
+}  // namespace arcsim

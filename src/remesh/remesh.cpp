@@ -1,0 +1,541 @@
+#include "remesh/remesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_set>
+#include <utility>
+
+#include "collision/distance.hpp"
+#include "mesh/edits.hpp"
+#include "mesh/validate.hpp"
+
+namespace arcsim {
+
+namespace {
+
+// Flips are refused across folds sharper than this (rad): flipping a bent quad's diagonal changes its shape.
+constexpr double kMaxFlipBend = 40.0 * M_PI / 180.0;
+// ARCSim refuses a split whose child would be this thin (mean-ratio aspect).
+constexpr double kMinSplitAspect = 1e-3;
+// A collapse must keep new edges this far below the target length, so that a split does not undo it at once.
+constexpr double kCollapseMetricLimit = 0.9;
+// Collapses keep surviving faces at least this well shaped when the scene gives no aspect_min (ARCSim requires
+// it; without any bound a collapse may leave slivers that a curved rest shape cannot follow).
+constexpr double kDefaultAspectMin = 0.1;
+// A boundary node counts as lying on the straight line of its neighbours within this fraction of their distance.
+constexpr double kStraightBoundary = 1e-6;
+
+bool positive_finite(double x) { return std::isfinite(x) && x > 0; }
+
+int vert_at(const Mesh& m, int f, int n) {
+  const int c = m.corner_of_node(f, n);
+  return c == kNone ? kNone : m.faces[f].v[c];
+}
+
+Vec3 rest_cross(const Mesh& m, const std::array<int, 3>& v) {
+  return (m.verts[v[1]].u - m.verts[v[0]].u).cross(m.verts[v[2]].u - m.verts[v[0]].u);
+}
+
+Vec3 world_cross(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
+
+std::vector<int> node_faces(const Mesh& m, int n) {
+  std::vector<int> faces;
+  for (int v : m.nodes[n].verts)
+    for (int f : m.verts[v].faces) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+std::vector<int> edges_of_faces(const Mesh& m, const std::vector<int>& faces) {
+  std::vector<int> edges;
+  for (int f : faces)
+    if (!m.faces[f].dead) edges.insert(edges.end(), m.faces[f].e.begin(), m.faces[f].e.end());
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+// Linear part of the affine map taking a face's rest triangle to its world triangle, extended by mapping the
+// rest normal to the world normal (identity when the world triangle is degenerate).
+Mat3 rest_to_world_map(const Mesh& m, int f) {
+  const Face& face = m.faces[f];
+  const Vec3 &u0 = m.verts[face.v[0]].u, &u1 = m.verts[face.v[1]].u, &u2 = m.verts[face.v[2]].u;
+  const Vec3 &x0 = m.nodes[m.face_node(f, 0)].x, &x1 = m.nodes[m.face_node(f, 1)].x,
+             &x2 = m.nodes[m.face_node(f, 2)].x;
+  const Vec3 nu = (u1 - u0).cross(u2 - u0), nx = (x1 - x0).cross(x2 - x0);
+  if (!(nu.norm() > 0) || !(nx.norm() > 0)) return Mat3::Identity();
+  Mat3 Du, Dx;
+  Du << u1 - u0, u2 - u0, nu.normalized();
+  Dx << x1 - x0, x2 - x0, nx.normalized();
+  const Mat3 map = Dx * Du.inverse();
+  return map.allFinite() ? map : Mat3::Identity();
+}
+
+}  // namespace
+
+double triangle_aspect(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double area = 0.5 * (b - a).cross(c - a).norm();
+  const double perimeter = (b - a).norm() + (c - b).norm() + (a - c).norm();
+  if (!(perimeter > 0)) return 0;
+  return 12 * std::sqrt(3.0) * area / (perimeter * perimeter);
+}
+
+bool should_flip(const Mesh& m, int e, double threshold, double max_surface_change) {
+  const Edge& edge = m.edges[e];
+  if (edge.dead || edge.is_boundary() || edge.preserve) return false;
+  const int f0 = edge.f[0], f1 = edge.f[1];
+  const int i = edge.n[0], j = edge.n[1];
+  const int vi = vert_at(m, f0, i), vj = vert_at(m, f0, j);
+  if (vi != vert_at(m, f1, i) || vj != vert_at(m, f1, j)) return false;  // seam
+  if (m.faces[f0].material != m.faces[f1].material) return false;
+  const int k = m.opposite_node(e, f0), l = m.opposite_node(e, f1);
+  if (k == l || m.find_edge(k, l) != kNone) return false;
+  const int vk = vert_at(m, f0, k), vl = vert_at(m, f1, l);
+  if (std::abs(m.world_dihedral(e)) >= kMaxFlipBend) return false;
+
+  // Opposite angles in the mean metric, in the plane of the mean rest normal.
+  const Vec3 normal = m.faces[f0].rest_normal + m.faces[f1].rest_normal;
+  if (!(normal.norm() > 0)) return false;
+  const Vec3 n = normal.normalized();
+  Vec3 t1 = n.unitOrthogonal();
+  const Vec3 t2 = n.cross(t1);
+  Eigen::Matrix<double, 3, 2> B;
+  B << t1, t2;
+  const Mat3 M3 = 0.25 * (m.verts[vi].sizing + m.verts[vj].sizing + m.verts[vk].sizing + m.verts[vl].sizing);
+  const Mat2 M = B.transpose() * M3 * B;
+  const double det = M.determinant();
+  if (!(det > 0)) return false;
+  const double sqrt_det = std::sqrt(det);
+  auto p = [&](int v) -> Vec2 { return B.transpose() * m.verts[v].u; };
+  const Vec2 ui = p(vi), uj = p(vj), uk = p(vk), ul = p(vl);
+  auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
+  auto norm = [&](const Vec2& a) { return std::sqrt(std::max(a.dot(M * a), 0.0)); };
+  // Angle at k in triangle (i, j, k) and at l in (j, i, l); both triangles are counter-clockwise about n.
+  const Vec2 ki = ui - uk, kj = uj - uk, lj = uj - ul, li = ui - ul;
+  const double sin_k = sqrt_det * cross(ki, kj), cos_k = ki.dot(M * kj);
+  const double sin_l = sqrt_det * cross(lj, li), cos_l = lj.dot(M * li);
+  const double scale = norm(ki) * norm(kj) * norm(lj) * norm(li);
+  if (!(scale > 0)) return false;
+  // sin(alpha_k + alpha_l) < 0: the opposite angles sum to more than pi (both triangles valid in the plane).
+  if (!(sin_k > 0 && sin_l > 0)) return false;
+  if ((sin_k * cos_l + cos_k * sin_l) / scale >= -threshold) return false;
+
+  // The flipped quad must not fold sharply (rest or world) nor invert in world space. New faces (k, i, l) and
+  // (l, j, k): the new edge runs k -> l in the second, with wings j (second face) and i (first face).
+  const Vec3 &Ui = m.verts[vi].u, &Uj = m.verts[vj].u, &Uk = m.verts[vk].u, &Ul = m.verts[vl].u;
+  if (std::abs(dihedral_angle(Uk, Ul, Uj, Ui)) >= kMaxFlipBend) return false;
+  const Vec3 &xi = m.nodes[i].x, &xj = m.nodes[j].x, &xk = m.nodes[k].x, &xl = m.nodes[l].x;
+  if (std::abs(dihedral_angle(xk, xl, xj, xi)) >= kMaxFlipBend) return false;
+  const Vec3 old_normal = world_cross(xi, xj, xk) + world_cross(xj, xi, xl);
+  if (world_cross(xk, xi, xl).dot(old_normal) <= 0 || world_cross(xl, xj, xk).dot(old_normal) <= 0) return false;
+  if (max_surface_change > 0) {
+    // The flip replaces one diagonal of the quad by the other: the surface moves by their distance. The part
+    // of it that the rest shape has too (a curved rest surface) is no elastic change.
+    auto gap = [](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+      const Vec3 across = (b - a).cross(d - c);
+      return across.norm() > 0 ? std::abs((c - a).dot(across)) / across.norm() : 0.0;
+    };
+    const double change = std::abs(gap(xi, xj, xk, xl) - gap(Ui, Uj, Uk, Ul));
+    if (change > max_surface_change * (Uj - Ui).norm()) return false;
+  }
+  return true;
+}
+
+namespace {
+
+class Remesher {
+ public:
+  Remesher(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
+           const std::vector<int>* subset)
+      : m_(mesh), materials_(materials), o_(options), subset_(subset != nullptr) {
+    if (subset_) {
+      active_.assign(m_.faces.size(), 0);
+      for (int f : *subset)
+        if (f >= 0 && f < static_cast<int>(m_.faces.size()) && !m_.faces[f].dead) active_[f] = 1;
+    }
+    for (const Face& f : m_.faces)
+      if (!f.dead) ++live_faces_;
+    curved_reference_ = o_.reference != nullptr && o_.reference->kind() != "linear";
+    const RemeshingParams& r = o_.sizing.remeshing;
+    aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
+    min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
+  }
+
+  RemeshStats run() {
+    compute_vertex_sizing(m_, o_.sizing, o_.extras);
+    flip_edges(active_edges());
+    split_rounds();
+    collapse_rounds();
+    for (size_t f = 0; f < m_.faces.size(); ++f)
+      if (!m_.faces[f].dead && is_active(static_cast<int>(f))) stats_.active_faces.push_back(static_cast<int>(f));
+    return stats_;
+  }
+
+ private:
+  bool is_active(int f) const { return !subset_ || (f < static_cast<int>(active_.size()) && active_[f]); }
+
+  // An edge may be split when one of its faces is active (a border edge of a subset too, so that the refined
+  // region stays conforming), but flipped only when all its faces are: flips and collapses stay inside the
+  // subset, and only the children of active faces become active, so the region cannot creep outwards.
+  bool is_active_edge(int e) const {
+    const Edge& edge = m_.edges[e];
+    if (edge.dead) return false;
+    for (int s = 0; s < 2; ++s)
+      if (edge.f[s] != kNone && is_active(edge.f[s])) return true;
+    return false;
+  }
+
+  bool is_inner_edge(int e) const {
+    const Edge& edge = m_.edges[e];
+    if (edge.dead) return false;
+    for (int s = 0; s < 2; ++s)
+      if (edge.f[s] != kNone && !is_active(edge.f[s])) return false;
+    return true;
+  }
+
+  bool node_inside(int n) const {
+    for (int f : node_faces(m_, n))
+      if (!is_active(f)) return false;
+    return true;
+  }
+
+  std::vector<int> active_edges() const {
+    std::vector<int> edges;
+    for (size_t e = 0; e < m_.edges.size(); ++e)
+      if (is_active_edge(static_cast<int>(e))) edges.push_back(static_cast<int>(e));
+    return edges;
+  }
+
+  // Counts the faces and marks new faces active: all of them (flips and collapses act inside the subset), or,
+  // for splits, a child when its parent was (active_by_corner: each parent's corner opposite the edge).
+  void record(const EditResult& r, const std::vector<std::pair<int, bool>>* active_by_corner = nullptr) {
+    live_faces_ += static_cast<long>(r.added_faces.size()) - static_cast<long>(r.removed_faces.size());
+    if (!subset_) return;
+    if (active_.size() < m_.faces.size()) active_.resize(m_.faces.size(), 0);
+    for (int f : r.added_faces) {
+      bool active = active_by_corner == nullptr;
+      if (!active)
+        for (const auto& [node, parent_active] : *active_by_corner)
+          if (m_.corner_of_node(f, node) != kNone) active = parent_active;
+      active_[f] = active;
+    }
+  }
+
+  // --- rest angles ----------------------------------------------------------------------------------------
+
+  bool on_reference(int v) const {
+    const Vec3& u = m_.verts[v].u;
+    const double tolerance = 1e-9 * (1 + u.norm());
+    return (o_.reference->closest_point(u) - u).norm() <= tolerance;
+  }
+
+  // The reference surface's rest dihedral of an interior, non-seam edge (0 otherwise, like Mesh::rest_dihedral).
+  // A vert left off the surface (its projection was refused) makes the actual rest triangles the stress-free
+  // shape, so the geometric rest dihedral is used there.
+  double reference_dihedral(int e) const {
+    const Edge& edge = m_.edges[e];
+    if (edge.is_boundary()) return 0;
+    const int f0 = edge.f[0], f1 = edge.f[1];
+    const int a0 = vert_at(m_, f0, edge.n[0]), a1 = vert_at(m_, f0, edge.n[1]);
+    if (a0 != vert_at(m_, f1, edge.n[0]) || a1 != vert_at(m_, f1, edge.n[1])) return 0;
+    const int a2 = vert_at(m_, f0, m_.opposite_node(e, f0)), b3 = vert_at(m_, f1, m_.opposite_node(e, f1));
+    for (int v : {a0, a1, a2, b3})
+      if (!on_reference(v)) return m_.rest_dihedral(e);
+    return o_.reference->rest_dihedral(m_.verts[a0].u, m_.verts[a1].u, m_.verts[a2].u, m_.verts[b3].u);
+  }
+
+  // Plastic offsets (rest angle minus geometric rest dihedral) of the edges, as the edits left them.
+  std::vector<double> plastic_offsets(const std::vector<int>& edges) const {
+    std::vector<double> offsets;
+    for (int e : edges) offsets.push_back(m_.edges[e].rest_theta - m_.rest_dihedral(e));
+    return offsets;
+  }
+
+  // Rest angle = plastic offset + the reference's dihedral of the current rest triangles. Without a curved
+  // reference the edits' geometric rest dihedral is already the right one.
+  void apply_rest_angles(const std::vector<int>& edges, const std::vector<double>& offsets) {
+    for (size_t i = 0; i < edges.size(); ++i) {
+      const int e = edges[i];
+      if (m_.edges[e].dead) continue;
+      const double base = curved_reference_ ? reference_dihedral(e) : m_.rest_dihedral(e);
+      m_.edges[e].rest_theta = offsets[i] + base;
+    }
+  }
+
+  void refresh_rest_angles(const std::vector<int>& faces) {
+    if (!curved_reference_) return;
+    const std::vector<int> edges = edges_of_faces(m_, faces);
+    apply_rest_angles(edges, plastic_offsets(edges));
+  }
+
+  void reproject(int node) {
+    if (!o_.reproject || m_.nodes[node].preserve) return;
+    if (reproject_node(m_, materials_, node, o_.reprojection).moved) ++stats_.reprojections;
+  }
+
+  // --- flips ------------------------------------------------------------------------------------------------
+
+  // Flips on independent sets: within a pass no two flipped edges share a face (an edge whose face was
+  // already changed waits for the next pass), and the edges of flipped faces are examined again next pass.
+  void flip_edges(std::vector<int> queue) {
+    const size_t budget = 3 * queue.size() + 16;
+    size_t done = 0;
+    for (int pass = 0; pass < 50 && !queue.empty() && done < budget; ++pass) {
+      std::unordered_set<int> used;
+      std::vector<int> next;
+      for (int e : queue) {
+        if (done >= budget) break;
+        if (!is_inner_edge(e) || m_.edges[e].is_boundary()) continue;
+        const int f0 = m_.edges[e].f[0], f1 = m_.edges[e].f[1];
+        if (used.count(f0) || used.count(f1)) {
+          next.push_back(e);
+          continue;
+        }
+        if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change)) continue;
+        const EditResult r = flip_edge(m_, e);
+        if (!r.ok) continue;
+        ++done;
+        ++stats_.flips;
+        record(r);
+        refresh_rest_angles(r.added_faces);
+        used.insert(r.added_faces.begin(), r.added_faces.end());
+        for (int ne : edges_of_faces(m_, r.added_faces)) next.push_back(ne);
+      }
+      std::sort(next.begin(), next.end());
+      next.erase(std::unique(next.begin(), next.end()), next.end());
+      queue = std::move(next);
+    }
+  }
+
+  void flip_around(int node) { flip_edges(edges_of_faces(m_, node_faces(m_, node))); }
+
+  // --- splits -----------------------------------------------------------------------------------------------
+
+  bool split_children_ok(int e) const {
+    const Edge& edge = m_.edges[e];
+    for (int s = 0; s < 2; ++s) {
+      const int f = edge.f[s];
+      if (f == kNone) continue;
+      const int a = vert_at(m_, f, edge.n[0]), b = vert_at(m_, f, edge.n[1]);
+      const int c = vert_at(m_, f, m_.opposite_node(e, f));
+      const Vec3 mid = 0.5 * (m_.verts[a].u + m_.verts[b].u);
+      const Vec3& uc = m_.verts[c].u;
+      if (triangle_aspect(m_.verts[a].u, mid, uc) < kMinSplitAspect ||
+          triangle_aspect(mid, m_.verts[b].u, uc) < kMinSplitAspect)
+        return false;
+    }
+    return true;
+  }
+
+  // Moves the new vert's rest position onto the reference along its averaged rest normal, if the faces stay
+  // valid (not degenerate, normals turned by less than 60 degrees).
+  void project_vert(int v, double max_distance) {
+    Vert& vert = m_.verts[v];
+    Vec3 normal = Vec3::Zero();
+    for (int f : vert.faces) normal += m_.faces[f].rest_area * m_.faces[f].rest_normal;
+    const Vec3 target = o_.reference->project(vert.u, normal, max_distance);
+    if (!target.allFinite() || target == vert.u) return;
+    const Vec3 old = vert.u;
+    std::vector<Vec3> old_normals;
+    for (int f : vert.faces) old_normals.push_back(rest_cross(m_, m_.faces[f].v));
+    vert.u = target;
+    for (size_t i = 0; i < vert.faces.size(); ++i) {
+      const std::array<int, 3>& fv = m_.faces[vert.faces[i]].v;
+      const Vec3 n = rest_cross(m_, fv);
+      if (rest_triangle_degenerate(m_.verts[fv[0]].u, m_.verts[fv[1]].u, m_.verts[fv[2]].u) ||
+          n.dot(old_normals[i]) <= 0.5 * n.norm() * old_normals[i].norm()) {
+        vert.u = old;
+        return;
+      }
+    }
+  }
+
+  bool split(int e) {
+    if (!split_children_ok(e)) return false;
+    const double rest_length = [&] {
+      double l = 0;
+      for (int s = 0; s < 2; ++s) {
+        const int f = m_.edges[e].f[s];
+        if (f == kNone) continue;
+        l = std::max(l, (m_.verts[vert_at(m_, f, m_.edges[e].n[1])].u - m_.verts[vert_at(m_, f, m_.edges[e].n[0])].u).norm());
+      }
+      return l;
+    }();
+    // Children are told apart by the parent's corner opposite the edge.
+    std::vector<std::pair<int, bool>> active_by_corner;
+    for (int s = 0; s < 2; ++s) {
+      const int f = m_.edges[e].f[s];
+      if (f != kNone) active_by_corner.emplace_back(m_.opposite_node(e, f), is_active(f));
+    }
+    const EditResult r = split_edge(m_, e, 0.5);
+    if (!r.ok) return false;
+    ++stats_.splits;
+    record(r, &active_by_corner);
+    const int node = r.added_nodes[0];
+
+    // Initial world guess follows the rest displacement through the old faces' deformation.
+    Mat3 map = Mat3::Zero();
+    for (int f : r.added_faces) map += rest_to_world_map(m_, f) / static_cast<double>(r.added_faces.size());
+    const std::vector<int> edges = edges_of_faces(m_, r.added_faces);
+    const std::vector<double> offsets = plastic_offsets(edges);
+    if (o_.reference != nullptr && !r.added_verts.empty()) {
+      const Vec3 before = m_.verts[r.added_verts[0]].u;
+      for (int v : r.added_verts) project_vert(v, rest_length);
+      for (int f : r.added_faces) m_.update_rest_data(f);
+      apply_rest_angles(edges, offsets);
+      const Vec3 shift = map * (m_.verts[r.added_verts[0]].u - before);
+      if (shift.allFinite()) {
+        m_.nodes[node].x += shift;
+        m_.nodes[node].x0 += shift;
+      }
+    }
+    reproject(node);
+    flip_around(node);
+    return true;
+  }
+
+  void split_rounds() {
+    for (int round = 0; round < o_.max_rounds; ++round) {
+      std::vector<std::pair<double, int>> long_edges;
+      for (int e : active_edges()) {
+        const double l = edge_metric_length(m_, e);
+        if (l > 1) long_edges.emplace_back(l, e);
+      }
+      if (long_edges.empty()) return;
+      std::sort(long_edges.begin(), long_edges.end(),
+                [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+      int count = 0;
+      for (const auto& [length, e] : long_edges) {
+        if (live_faces_ >= static_cast<long>(o_.max_faces)) return;
+        if (!m_.edges[e].dead && split(e)) ++count;
+      }
+      if (count == 0) return;
+    }
+  }
+
+  // --- collapses --------------------------------------------------------------------------------------------
+
+  // ARCSim's collapse rules (facts §5.3) on the faces that survive around the removed node, checked before the
+  // edit: mean-ratio aspect at least aspect_min (or, for a face already below it, no worse than before), rest
+  // area at least 0.1 size_min^2 (or no smaller than before), rest normal not reversed, world normal not
+  // reversed, every new edge's metric length <= 0.9. The removed node must be unpreserved, unlabelled and, on
+  // the boundary, on a straight piece of it (boundary_node_on_chord); topology (boundary, preserved edges, link condition, seams) is checked by collapse_edge itself.
+  bool can_collapse(int e, int remove_side) const {
+    const Edge& edge = m_.edges[e];
+    const int gone = edge.n[remove_side], keep = edge.n[1 - remove_side];
+    const Node& g = m_.nodes[gone];
+    if (g.preserve || g.label != 0 || !node_inside(gone)) return false;
+    std::map<int, int> vert_map;
+    for (int s = 0; s < 2; ++s)
+      if (edge.f[s] != kNone) vert_map[vert_at(m_, edge.f[s], gone)] = vert_at(m_, edge.f[s], keep);
+    if (m_.is_boundary_node(gone) && !boundary_node_on_chord(gone)) return false;
+    const Vec3& x_keep = m_.nodes[keep].x;
+    double gone_to_surface = kInfinity, gone_to_rest_surface = kInfinity;  // m
+    for (int f : node_faces(m_, gone)) {
+      if (f == edge.f[0] || f == edge.f[1]) continue;
+      const Face& face = m_.faces[f];
+      const int c = m_.corner_of_node(f, gone);
+      const auto it = vert_map.find(face.v[c]);
+      if (it == vert_map.end()) return false;
+      std::array<int, 3> nv = face.v;
+      nv[c] = it->second;
+      const Vec3 &u0 = m_.verts[nv[0]].u, &u1 = m_.verts[nv[1]].u, &u2 = m_.verts[nv[2]].u;
+      const Vec3 &o0 = m_.verts[face.v[0]].u, &o1 = m_.verts[face.v[1]].u, &o2 = m_.verts[face.v[2]].u;
+      const double aspect = triangle_aspect(u0, u1, u2), old_aspect = triangle_aspect(o0, o1, o2);
+      if (aspect < std::min(aspect_min_, old_aspect) || aspect < std::min(kMinSplitAspect, old_aspect)) return false;
+      const Vec3 n = (u1 - u0).cross(u2 - u0), old_n = (o1 - o0).cross(o2 - o0);
+      if (0.5 * n.norm() < std::min(min_area_, 0.5 * old_n.norm())) return false;
+      if (n.dot(old_n) <= 0) return false;
+      std::array<Vec3, 3> x, old_x;
+      for (int i = 0; i < 3; ++i) old_x[i] = x[i] = m_.nodes[m_.face_node(f, i)].x;
+      x[c] = x_keep;
+      const Vec3 wn = world_cross(x[0], x[1], x[2]), old_wn = world_cross(old_x[0], old_x[1], old_x[2]);
+      if (wn.dot(old_wn) <= 0 && old_wn.norm() > 0) return false;
+      for (int k = 1; k <= 2; ++k)
+        if (vert_pair_metric_length(m_, it->second, nv[(c + k) % 3]) > kCollapseMetricLimit) return false;
+      gone_to_surface = std::min(gone_to_surface, vertex_face_closest(g.x, x[0], x[1], x[2]).distance);
+      gone_to_rest_surface = std::min(gone_to_rest_surface, vertex_face_closest(m_.verts[face.v[c]].u, u0, u1, u2).distance);
+    }
+    // The removed node's distance to the faces that replace its fan bounds how far the surface moves; the part
+    // the rest shape has too (a curved rest surface being coarsened) is no elastic change.
+    if (o_.max_surface_change > 0 && std::isfinite(gone_to_surface) && std::isfinite(gone_to_rest_surface)) {
+      const int f = edge.f[0] != kNone ? edge.f[0] : edge.f[1];
+      const double rest_length = (m_.verts[vert_at(m_, f, gone)].u - m_.verts[vert_at(m_, f, keep)].u).norm();
+      if (std::abs(gone_to_surface - gone_to_rest_surface) > o_.max_surface_change * rest_length) return false;
+    }
+    return true;
+  }
+
+  // A boundary node may go only where the boundary runs straight through it in rest space (it was made by a
+  // split of a boundary edge): removing a corner would change the sheet's outline or a crack's path.
+  bool boundary_node_on_chord(int node) const {
+    std::vector<Vec3> ends;
+    Vec3 here = Vec3::Zero();
+    for (int e : m_.nodes[node].edges) {
+      const Edge& edge = m_.edges[e];
+      if (!edge.is_boundary()) continue;
+      const int f = edge.f[0] != kNone ? edge.f[0] : edge.f[1];
+      const int other = edge.n[0] == node ? edge.n[1] : edge.n[0];
+      here = m_.verts[vert_at(m_, f, node)].u;
+      ends.push_back(m_.verts[vert_at(m_, f, other)].u);
+    }
+    if (ends.size() != 2) return false;
+    const Vec3 chord = ends[1] - ends[0];
+    const double length = chord.norm();
+    if (!(length > 0)) return false;
+    const double off_line = chord.cross(here - ends[0]).norm() / length;
+    return off_line <= kStraightBoundary * length;
+  }
+
+  bool collapse(int e) {
+    for (int side = 0; side < 2; ++side) {
+      if (!can_collapse(e, side)) continue;
+      const int keep = m_.edges[e].n[1 - side];
+      const EditResult r = collapse_edge(m_, e, side);
+      if (!r.ok) continue;
+      ++stats_.collapses;
+      record(r);
+      refresh_rest_angles(r.added_faces);
+      reproject(keep);
+      flip_around(keep);
+      return true;
+    }
+    return false;
+  }
+
+  void collapse_rounds() {
+    for (int round = 0; round < o_.max_rounds; ++round) {
+      std::vector<std::pair<double, int>> short_edges;
+      for (int e : active_edges()) {
+        const double l = edge_metric_length(m_, e);
+        if (l < 1) short_edges.emplace_back(l, e);
+      }
+      std::sort(short_edges.begin(), short_edges.end());
+      int count = 0;
+      for (const auto& [length, e] : short_edges)
+        if (!m_.edges[e].dead && collapse(e)) ++count;
+      if (count == 0) return;
+    }
+  }
+
+  Mesh& m_;
+  const std::vector<Material>& materials_;
+  const RemeshOptions& o_;
+  bool subset_;
+  std::vector<char> active_;
+  long live_faces_ = 0;
+  bool curved_reference_ = false;
+  double aspect_min_ = 0, min_area_ = 0;
+  RemeshStats stats_;
+};
+
+}  // namespace
+
+RemeshStats remesh_mesh(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
+                        const std::vector<int>* face_subset) {
+  return Remesher(mesh, materials, options, face_subset).run();
+}
+
+}  // namespace arcsim

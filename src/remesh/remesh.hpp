@@ -1,0 +1,64 @@
+// Adaptive anisotropic remeshing of a sheet (paper §5, Narain et al. 2012; facts §5.3): edge splits, flips and
+// collapses driven by the sizing metric (remesh/sizing.hpp), over the whole mesh or a subset of faces.
+//
+// One pass:
+//  1. vert sizing from the current state (area-weighted mean of face metrics);
+//  2. anisotropic Delaunay flips (Bossen-Heckbert) on independent edge sets;
+//  3. rounds of splits: every edge of metric length > 1, longest first, at its midpoint; flips around each;
+//  4. rounds of collapses: edges of metric length < 1, shortest first, either end, under ARCSim's quality
+//     rules (see can_collapse in remesh.cpp); flips around each.
+// Every rest position a split creates is projected onto the cloth's reference surface along the averaged rest
+// normal, and edges whose faces change get rest angle = plastic offset + the reference's rest dihedral, so a
+// curved rest shape stays curved. After every split and collapse the changed node's world position is
+// reprojected (remesh/reprojection.hpp, paper Eq. 13). Loops are bounded (rounds, flips per call, face count).
+// The mesh is left with tombstones: the caller compacts.
+#pragma once
+
+#include <vector>
+
+#include "mesh/mesh.hpp"
+#include "physics/material.hpp"
+#include "remesh/reprojection.hpp"
+#include "remesh/sizing.hpp"
+#include "restshape/reference_surface.hpp"
+
+namespace arcsim {
+
+struct RemeshOptions {
+  SizingParams sizing;    // remeshing parameters (sizes, refine_*, aspect_min) and magic knobs
+  SizingExtras extras;    // hooks: fracture / obstacle terms, plastic transform, uniform size
+  double edge_flip_threshold = 1e-2;   // magic.edge_flip_threshold: flip when sin(sum of opposite angles) < -this
+  const ReferenceSurface* reference = nullptr;  // where new rest positions go; nullptr: left on the chord
+  bool reproject = true;               // world-space reprojection after every split / collapse
+  ReprojectionParams reprojection;
+  // Collapses and flips may change the world surface, beyond what the rest surface changes, by at most this
+  // fraction of the edge's rest length: the removed node's distance to the new faces, the distance between the
+  // quad's diagonals (world minus rest). WHY: the sizing lets an edge bend by up to refine_angle, and flattening
+  // such a wrinkle in one remesh is a visible pop (ARCSim's square-pop scene). <= 0: no limit.
+  double max_surface_change = 0.005;
+  int max_rounds = 30;                 // split rounds and collapse rounds, each
+  size_t max_faces = 2000000;          // no split beyond this many live faces (a safety net, not a size control)
+};
+
+struct RemeshStats {
+  int splits = 0, flips = 0, collapses = 0, reprojections = 0;
+  // Live faces of the active region after the pass: the subset's surviving faces plus every face created
+  // (all live faces when no subset was given). Indices before compaction.
+  std::vector<int> active_faces;
+};
+
+// Remeshes `mesh` (whole mesh, or only the edges of the faces in `face_subset` when it is not null; the edits
+// may still change faces just outside, as a split of a border edge must).
+RemeshStats remesh_mesh(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
+                        const std::vector<int>* face_subset = nullptr);
+
+// Anisotropic Delaunay test of an interior edge (Bossen-Heckbert) in the mean metric of its four verts, with the
+// flip restrictions of facts §5.3 (no boundary / seam / preserved edge, world dihedral and flipped rest and
+// world dihedral below 40 degrees, no world-space inversion) and the world-surface limit (see
+// RemeshOptions::max_surface_change). Uses the verts' current sizing.
+bool should_flip(const Mesh& mesh, int edge, double threshold, double max_surface_change = 0);
+
+// Mean ratio quality 12 sqrt(3) area / perimeter^2 of a triangle (1 for equilateral, 0 for degenerate).
+double triangle_aspect(const Vec3& a, const Vec3& b, const Vec3& c);
+
+}  // namespace arcsim

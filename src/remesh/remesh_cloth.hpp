@@ -1,0 +1,42 @@
+// Remeshing of a simulation cloth: options from the scene, the per-cloth entry point used at frame ends and by
+// fracture (whole mesh or a face subset), ARCSim's fixed high-resolution refinement, and mesh-size statistics
+// for the per-frame log.
+#pragma once
+
+#include <vector>
+
+#include "remesh/remesh.hpp"
+#include "scene/scene.hpp"
+#include "sim/simulation.hpp"
+
+namespace arcsim {
+
+// Options from the scene: magic rib_stiffening, combine_tensors and edge_flip_threshold, gravity for the
+// reprojection. The per-cloth fields (remeshing parameters, reference) are filled in by remesh().
+// The obstacle-proximity sizing term stays off: the collision module provides no nearest obstacle planes yet.
+RemeshOptions remesh_options(const Scene& scene);
+
+// Remeshes one cloth (see remesh_mesh) with its own remeshing parameters and reference surface (those fields of
+// `options` are overridden). Marks the cloth's elements dirty and recomputes its node masses. Does not compact:
+// the caller compacts (and remaps what holds node indices, see remap_handles).
+RemeshStats remesh(Cloth& cloth, const std::vector<int>* face_subset, const RemeshOptions& options);
+
+// ARCSim's `fixed_high_res_mesh`: one isotropic remesh of the whole cloth to its size_min (nothing else enters
+// the sizing). Does nothing if size_min is not finite and positive.
+RemeshStats refine_to_size_min(Cloth& cloth, const RemeshOptions& options);
+
+// Maps the node indices of the handles of cloth `cloth` through a compaction. Handle nodes are preserved by
+// remeshing, so none of them disappears; a handle node that did (fracture may remove nothing either) is
+// dropped with its anchor.
+void remap_handles(std::vector<Handle>& handles, int cloth, const Mesh::Compaction& compaction);
+
+// Mesh size at a moment, for the per-frame log: live face and node counts and the min / median / max world
+// edge length (m), and the same for rest-space lengths.
+struct MeshSizeStats {
+  int faces = 0, nodes = 0, edges = 0;
+  double edge_min = 0, edge_median = 0, edge_max = 0;                 // world, m
+  double rest_edge_min = 0, rest_edge_median = 0, rest_edge_max = 0;  // rest space, m
+};
+MeshSizeStats mesh_size_stats(const Mesh& mesh);
+
+}  // namespace arcsim

@@ -1,0 +1,238 @@
+#include "remesh/reprojection.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "physics/bending.hpp"
+#include "physics/membrane.hpp"
+#include "physics/plate_bending.hpp"
+
+namespace arcsim {
+
+namespace {
+
+// The same per-face element data as the physics' element cache (physics/cloth_physics.cpp), for the few faces
+// around one node.
+struct MembraneElement {
+  std::array<int, 3> nodes;
+  Mat2 Dm_inv;  // includes the plastic stretch
+  double area;
+  MembraneStiffness k;
+};
+
+struct BendingElement {
+  std::array<int, 6> nodes;  // corners, then wings (a missing wing repeats corner 0)
+  std::array<bool, 3> has_wing;
+  Vec3 rest_theta;
+  Mat3 Q;
+};
+
+struct Elements {
+  std::vector<MembraneElement> membrane;
+  std::vector<BendingElement> bending;
+  double mass = 0;  // kg
+};
+
+MembraneElement membrane_element(const Mesh& mesh, const std::vector<Material>& materials, int f) {
+  const Face& face = mesh.faces[f];
+  const Material& m = materials[face.material];
+  MembraneElement el;
+  for (int i = 0; i < 3; ++i) el.nodes[i] = mesh.face_node(f, i);
+  const Mat2 Fp = face.Fp.isIdentity(0) ? Mat2::Identity() : Mat2(face.rest_frame.transpose() * face.Fp * face.rest_frame);
+  el.Dm_inv = face.Dm_inv * Fp;
+  el.area = face.rest_area;
+  el.k = m.membrane_stiffness(face.thickness);
+  const double w = 1.0 / (1.0 + m.weakening * face.damage);
+  el.k.k11 *= w, el.k.k12 *= w, el.k.k22 *= w, el.k.k33 *= w;
+  return el;
+}
+
+BendingElement bending_element(const Mesh& mesh, const std::vector<Material>& materials, int f) {
+  const Face& face = mesh.faces[f];
+  const Material& m = materials[face.material];
+  BendingElement b;
+  std::array<double, 3> lengths, kb;
+  std::array<Vec3, 3> normals;
+  for (int i = 0; i < 3; ++i) {
+    const int e = face.e[i];
+    b.nodes[i] = mesh.face_node(f, i);
+    const int other = mesh.other_face(e, f);
+    b.has_wing[i] = other != kNone;
+    b.nodes[3 + i] = other != kNone ? mesh.opposite_node(e, other) : kNone;
+    b.rest_theta[i] = mesh.edges[e].rest_theta;
+    const Vec3 d = mesh.verts[face.v[(i + 1) % 3]].u - mesh.verts[face.v[i]].u;
+    lengths[i] = d.norm();
+    normals[i] = lengths[i] > 0 ? Vec3(d.cross(face.rest_normal) / lengths[i]) : Vec3::Zero();
+    const double angle = std::atan2(face.rest_frame.col(1).dot(d), face.rest_frame.col(0).dot(d));
+    kb[i] = m.bending_stiffness(face.thickness, angle) / (1.0 + m.weakening * mesh.edges[e].damage);
+  }
+  for (int i = 0; i < 3; ++i)
+    if (!b.has_wing[i]) b.nodes[3 + i] = b.nodes[0];
+  const double nu = m.data_driven ? 0.0 : m.poisson_ratio;
+  b.Q = plate_bending_matrix(lengths, normals, face.rest_area, 1.0, nu, b.has_wing);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) b.Q(i, j) *= std::sqrt(kb[i] * kb[j]);
+  return b;
+}
+
+std::vector<int> node_faces(const Mesh& mesh, int node) {
+  std::vector<int> faces;
+  for (int v : mesh.nodes[node].verts)
+    for (int f : mesh.verts[v].faces) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+Elements gather_elements(const Mesh& mesh, const std::vector<Material>& materials, int node) {
+  Elements els;
+  const std::vector<int> incident = node_faces(mesh, node);
+  std::vector<int> bending_faces = incident;
+  for (int f : incident) {
+    const Face& face = mesh.faces[f];
+    const int c = mesh.corner_of_node(f, node);
+    // The face across the edge opposite the node has the node as a wing.
+    const int across = mesh.other_face(face.e[(c + 1) % 3], f);
+    if (across != kNone) bending_faces.push_back(across);
+    els.membrane.push_back(membrane_element(mesh, materials, f));
+    els.mass += materials[face.material].area_density(face.thickness) * face.rest_area / 3;
+  }
+  std::sort(bending_faces.begin(), bending_faces.end());
+  bending_faces.erase(std::unique(bending_faces.begin(), bending_faces.end()), bending_faces.end());
+  for (int f : bending_faces) els.bending.push_back(bending_element(mesh, materials, f));
+  return els;
+}
+
+// The node's share of a bending element's Gauss-Newton Hessian, 2 sum_ij Q_ij a_i a_j^T with a_i the
+// derivative of edge i's dihedral angle with respect to the node (the same approximation as
+// plate_bending_terms' kProjected, without forming the 18 x 18 matrix).
+Mat3 bending_hessian_block(const BendingElement& b, const std::array<Vec3, 6>& xs, int node) {
+  std::array<Vec3, 3> a;
+  for (int i = 0; i < 3; ++i) {
+    a[i].setZero();
+    if (!b.has_wing[i]) continue;
+    // Hinge of edge i in dihedral_angle's order: corners i, i+1, i+2, then wing i.
+    const std::array<int, 4> slots{i, (i + 1) % 3, (i + 2) % 3, 3 + i};
+    bool touches = false;
+    for (int s : slots) touches = touches || b.nodes[s] == node;
+    if (!touches) continue;
+    const Vec12 g = dihedral_angle_gradient(xs[slots[0]], xs[slots[1]], xs[slots[2]], xs[slots[3]]);
+    for (int k = 0; k < 4; ++k)
+      if (b.nodes[slots[k]] == node) a[i] += g.segment<3>(3 * k);
+  }
+  Mat3 H = Mat3::Zero();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (b.Q(i, j) != 0) H += 2 * b.Q(i, j) * a[i] * a[j].transpose();
+  return H;
+}
+
+// The load's potential is measured from `origin` (any fixed point): a constant offset, chosen so that the
+// line search compares energies of similar size instead of differences lost in the rounding of load . x.
+LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3& x, const Vec3& load,
+                     const Vec3& origin, bool with_hessian) {
+  LocalEnergy out;
+  auto position = [&](int n) -> const Vec3& { return n == node ? x : mesh.nodes[n].x; };
+  const HessianKind kind = with_hessian ? HessianKind::kProjected : HessianKind::kNone;
+  for (const MembraneElement& el : els.membrane) {
+    const MembraneTerms t = membrane_terms(position(el.nodes[0]), position(el.nodes[1]), position(el.nodes[2]),
+                                           el.Dm_inv, el.area, el.k, 1.0, kind);
+    out.energy += t.energy;
+    for (int i = 0; i < 3; ++i)
+      if (el.nodes[i] == node) {
+        out.gradient += t.gradient.segment<3>(3 * i);
+        if (with_hessian) out.hessian += t.hessian.block<3, 3>(3 * i, 3 * i);
+      }
+  }
+  for (const BendingElement& b : els.bending) {
+    std::array<Vec3, 6> xs;
+    for (int i = 0; i < 6; ++i) xs[i] = position(b.nodes[i]);
+    const PlateBendingTerms t = plate_bending_terms(xs, b.has_wing, b.rest_theta, b.Q, HessianKind::kNone);
+    out.energy += t.energy;
+    // The node may fill several slots (a corner and, on a tiny mesh, a wing): the derivative sums them.
+    for (int i = 0; i < 6; ++i)
+      if (b.nodes[i] == node && (i < 3 || b.has_wing[i - 3])) out.gradient += t.gradient.segment<3>(3 * i);
+    if (with_hessian) out.hessian += bending_hessian_block(b, xs, node);
+  }
+  out.energy += load.dot(x - origin);
+  out.gradient += load;
+  return out;
+}
+
+// A typical rest edge length around the node (m), to scale step limits and tolerances.
+double local_length(const Mesh& mesh, int node) {
+  double sum = 0;
+  int count = 0;
+  for (int e : mesh.nodes[node].edges) {
+    const Edge& ed = mesh.edges[e];
+    sum += (mesh.nodes[ed.n[1]].x - mesh.nodes[ed.n[0]].x).norm();
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+}  // namespace
+
+LocalEnergy node_local_energy(const Mesh& mesh, const std::vector<Material>& materials, int node, const Vec3& x,
+                              const ReprojectionParams& params) {
+  const Elements els = gather_elements(mesh, materials, node);
+  return evaluate(mesh, els, node, x, els.mass * (mesh.nodes[node].a - params.gravity), Vec3::Zero(), true);
+}
+
+ReprojectionResult reproject_node(Mesh& mesh, const std::vector<Material>& materials, int node,
+                                  const ReprojectionParams& params) {
+  ReprojectionResult result;
+  const Elements els = gather_elements(mesh, materials, node);
+  if (els.membrane.empty()) return result;
+  const Vec3 load = els.mass * (mesh.nodes[node].a - params.gravity);
+  const double length = local_length(mesh, node);
+  if (!(length > 0)) return result;
+  const Vec3 start = mesh.nodes[node].x;
+  Vec3 x = start;
+  LocalEnergy current = evaluate(mesh, els, node, x, load, start, true);
+  result.energy_before = result.energy_after = current.energy;
+  if (!std::isfinite(current.energy)) return result;
+
+  for (int it = 0; it < params.max_iterations; ++it) {
+    result.iterations = it + 1;
+    const Mat3& H = current.hessian;
+    const double reg = 1e-10 * std::max(H.trace() / 3, 0.0) + 1e-300;
+    Vec3 step = -(H + reg * Mat3::Identity()).ldlt().solve(current.gradient);
+    if (!step.allFinite() || step.dot(current.gradient) >= 0) {
+      // No usable curvature: a gradient step scaled to the local length.
+      const double g = current.gradient.norm();
+      if (!(g > 0)) break;
+      step = -(0.1 * length / g) * current.gradient;
+    }
+    // A step longer than the neighbourhood cannot be trusted to a quadratic model.
+    const double norm = step.norm();
+    if (norm > length) step *= length / norm;
+    // Converged when the Newton step is a rounding-level displacement.
+    if (step.norm() <= 1e-12 * length) break;
+    bool accepted = false;
+    double alpha = 1;
+    LocalEnergy trial;
+    for (int ls = 0; ls < 16; ++ls, alpha *= 0.5) {
+      trial = evaluate(mesh, els, node, x + alpha * step, load, start, false);
+      if (std::isfinite(trial.energy) && trial.energy < current.energy) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    x += alpha * step;
+    current = evaluate(mesh, els, node, x, load, start, true);
+    if ((alpha * step).norm() < 1e-13 * length) break;
+  }
+  result.energy_after = current.energy;
+  if (x != start) {
+    Node& n = mesh.nodes[node];
+    n.x0 += x - start;
+    n.x = x;
+    result.moved = true;
+  }
+  return result;
+}
+
+}  // namespace arcsim

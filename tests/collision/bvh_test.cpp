@@ -1,0 +1,189 @@
+// Broad phase: BVH overlaps against all-pairs box tests, refitting, determinism across thread counts, and the
+// primitive candidates of whole meshes against brute force over every primitive pair.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "collision/bvh.hpp"
+#include "collision/candidates.hpp"
+#include "support/mesh_factory.hpp"
+
+namespace arcsim {
+namespace {
+
+std::vector<Aabb> random_boxes(int n, unsigned seed, double size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<Aabb> boxes(n);
+  for (auto& b : boxes) {
+    const Vec3 c(U(rng), U(rng), U(rng));
+    b.extend(c);
+    b.extend(c + size * Vec3(U(rng), U(rng), U(rng)));
+  }
+  return boxes;
+}
+
+std::vector<std::pair<int, int>> brute_self(const std::vector<Aabb>& boxes) {
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (size_t j = i + 1; j < boxes.size(); ++j)
+      if (boxes[i].overlaps(boxes[j])) pairs.emplace_back(i, j);
+  return pairs;
+}
+
+TEST(Bvh, SelfOverlapsMatchAllPairs) {
+  for (int n : {1, 2, 3, 17, 400}) {
+    const auto boxes = random_boxes(n, 1 + n, 0.08);
+    Bvh bvh;
+    bvh.build(boxes);
+    EXPECT_EQ(bvh.self_overlaps(), brute_self(boxes)) << n << " boxes";
+  }
+}
+
+TEST(Bvh, CrossOverlapsMatchAllPairs) {
+  const auto a = random_boxes(300, 5, 0.1), b = random_boxes(200, 6, 0.1);
+  Bvh ta, tb;
+  ta.build(a);
+  tb.build(b);
+  std::vector<std::pair<int, int>> expected;
+  for (size_t i = 0; i < a.size(); ++i)
+    for (size_t j = 0; j < b.size(); ++j)
+      if (a[i].overlaps(b[j])) expected.emplace_back(i, j);
+  EXPECT_EQ(ta.overlaps(tb), expected);
+  EXPECT_FALSE(expected.empty());
+}
+
+TEST(Bvh, RefitFollowsMovedBoxes) {
+  auto boxes = random_boxes(300, 9, 0.05);
+  Bvh bvh;
+  bvh.build(boxes);
+  // Move every box far and differently: the tree structure is now poor but must stay correct.
+  std::mt19937 rng(10);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (auto& b : boxes) {
+    const Vec3 shift(U(rng), U(rng), U(rng));
+    b.lo += shift;
+    b.hi += shift;
+  }
+  bvh.refit(boxes);
+  EXPECT_EQ(bvh.self_overlaps(), brute_self(boxes));
+}
+
+TEST(Bvh, OutputDoesNotDependOnThreadCount) {
+#ifdef _OPENMP
+  const auto boxes = random_boxes(2000, 12, 0.06);
+  Bvh bvh;
+  bvh.build(boxes);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto one = bvh.self_overlaps();
+  omp_set_num_threads(4);
+  const auto four = bvh.self_overlaps();
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one, four);
+  EXPECT_GT(one.size(), 100u);
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
+}
+
+// Brute force over every primitive pair of the geometry, with the same box and adjacency rules.
+std::vector<PrimitivePair> brute_candidates(const ContactGeometry& g, double margin, bool swept) {
+  auto node_box = [&](int n) {
+    Aabb b;
+    b.extend(g.x0[n]);
+    if (swept) b.extend(g.x1[n]);
+    b.inflate(0.5 * margin);
+    return b;
+  };
+  auto both_static = [&](int mesh_a, int mesh_b) {
+    return !g.meshes[mesh_a].deformable && !g.meshes[mesh_b].deformable;
+  };
+  std::vector<PrimitivePair> out;
+  for (int n = 0; n < g.node_count(); ++n) {
+    for (size_t f = 0; f < g.faces.size(); ++f) {
+      const auto& v = g.faces[f];
+      if (v[0] == n || v[1] == n || v[2] == n || both_static(g.node_mesh[n], g.node_mesh[v[0]])) continue;
+      Aabb fb;
+      for (int k : v) fb.extend(node_box(k));
+      if (node_box(n).overlaps(fb)) out.push_back({PairKind::kVertexFace, n, static_cast<int>(f)});
+    }
+  }
+  for (size_t a = 0; a < g.edges.size(); ++a) {
+    for (size_t b = a + 1; b < g.edges.size(); ++b) {
+      const auto &ea = g.edges[a], &eb = g.edges[b];
+      if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+      if (both_static(g.node_mesh[ea[0]], g.node_mesh[eb[0]])) continue;
+      Aabb ba = node_box(ea[0]), bb = node_box(eb[0]);
+      ba.extend(node_box(ea[1]));
+      bb.extend(node_box(eb[1]));
+      if (ba.overlaps(bb)) out.push_back({PairKind::kEdgeEdge, static_cast<int>(a), static_cast<int>(b)});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A crumpled sheet (random heights) above a static plate, moving down through it.
+struct TwoMeshes {
+  Mesh sheet, plate;
+  ContactGeometry g;
+  explicit TwoMeshes(unsigned seed) {
+    sheet = testing::make_grid(8, 8, 1, 1, testing::Diagonal::kAlternating);
+    plate = testing::make_grid(3, 3, 1.2, 1.2, testing::Diagonal::kForward, -0.1, -0.1);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> U(-1, 1);
+    for (Node& n : sheet.nodes) {
+      n.x0 = n.x + Vec3(0, 0, 0.05 + 0.04 * U(rng));
+      n.x = n.x0 + Vec3(0.02 * U(rng), 0.02 * U(rng), -0.1);
+      n.mass = 0.01;
+    }
+    for (Node& n : plate.nodes) n.x0 = n.x;
+    build_contact_geometry({{&sheet, true}, {&plate, false}}, ContactStage::kAfterStep, 0.01, g);
+  }
+};
+
+TEST(Candidates, MatchBruteForceForSweptAndStaticBoxes) {
+  for (unsigned seed : {1u, 2u}) {
+    TwoMeshes m(seed);
+    for (bool swept : {true, false}) {
+      BvhCache cache;
+      CandidateOptions options;
+      options.margin = 0.01;
+      options.swept = swept;
+      const auto found = find_candidates(m.g, cache, options);
+      const auto expected = brute_candidates(m.g, options.margin, swept);
+      EXPECT_EQ(found.size(), expected.size()) << "seed " << seed << " swept " << swept;
+      EXPECT_TRUE(found == expected) << "seed " << seed << " swept " << swept;
+      EXPECT_FALSE(found.empty());
+    }
+  }
+}
+
+TEST(Candidates, BvhIsRebuiltOnlyWhenTopologyChanges) {
+  TwoMeshes m(3);
+  BvhCache cache;
+  CandidateOptions options;
+  options.margin = 0.01;
+  find_candidates(m.g, cache, options);
+  EXPECT_EQ(cache.builds(), 2);
+  // Same topology, new positions: refit only.
+  for (Vec3& x : m.g.x1) x.z() -= 0.01;
+  find_candidates(m.g, cache, options);
+  EXPECT_EQ(cache.builds(), 2);
+  // New sheet topology: that mesh's tree is rebuilt.
+  m.sheet = testing::make_grid(5, 5, 1, 1);
+  for (Node& n : m.sheet.nodes) n.mass = 0.01;
+  build_contact_geometry({{&m.sheet, true}, {&m.plate, false}}, ContactStage::kAfterStep, 0.01, m.g);
+  find_candidates(m.g, cache, options);
+  EXPECT_EQ(cache.builds(), 3);
+}
+
+}  // namespace
+}  // namespace arcsim

@@ -1,0 +1,167 @@
+// Impact zones on whole meshes: motions that cross an obstacle or another sheet within one step are made
+// collision free (checked by re-running CCD and by the exact triangle intersection test), masses share the
+// correction, and an infeasible zone falls back to rigid motion / staying put with a warning.
+#include <gtest/gtest.h>
+
+#include "collision/impact_zones.hpp"
+#include "collision/proximity.hpp"
+#include "collision/tri_tri.hpp"
+#include "support/mesh_factory.hpp"
+
+namespace arcsim {
+namespace {
+
+constexpr double kH = 1e-4;  // projection thickness (m)
+
+ImpactZoneParams params() {
+  ImpactZoneParams p;
+  p.thickness = kH;
+  p.contact_distance = 1e-6;
+  return p;
+}
+
+Mesh sheet(int cells, double size, double x0, double y0, double mass) {
+  Mesh m = testing::make_grid(cells, cells, size, size, testing::Diagonal::kAlternating, x0, y0);
+  for (Node& n : m.nodes) n.mass = mass;
+  return m;
+}
+
+Mesh plate(double z) {
+  Mesh m = testing::make_grid(1, 1, 2, 2, testing::Diagonal::kForward, -1, -1);
+  for (Node& n : m.nodes) n.x.z() = z, n.x0 = n.x;
+  return m;
+}
+
+// Intersecting triangle pairs between two meshes of the geometry at the end positions x1.
+int intersections(const ContactGeometry& g, int mesh_a, int mesh_b) {
+  int n = 0;
+  const auto& ra = g.meshes[mesh_a];
+  const auto& rb = g.meshes[mesh_b];
+  for (int f = ra.face_begin; f < ra.face_end; ++f)
+    for (int h = rb.face_begin; h < rb.face_end; ++h) {
+      std::array<Vec3, 3> s, t;
+      for (int i = 0; i < 3; ++i) s[i] = g.x1[g.faces[f][i]], t[i] = g.x1[g.faces[h][i]];
+      n += testing::triangles_intersect(s, t);
+    }
+  return n;
+}
+
+TEST(ImpactZones, SheetPassingThroughPlateStopsAtTheGap) {
+  Mesh s = sheet(4, 0.2, 0.1, 0.15, 1e-3), p = plate(0);
+  for (Node& n : s.nodes) {
+    n.x0 = n.x + Vec3(0, 0, 0.01);
+    n.x = n.x + Vec3(0.003, 0, -0.01);
+  }
+  ContactGeometry g;
+  build_contact_geometry({{&s, true}, {&p, false}}, ContactStage::kAfterStep, 1e-3, g);
+  BvhCache cache;
+  ASSERT_FALSE(detect_impacts(g, cache, params()).empty());  // tunnels through within the step
+  const ImpactZoneStats stats = resolve_impacts(g, cache, params());
+  EXPECT_TRUE(stats.resolved);
+  EXPECT_EQ(stats.fallback_zones, 0);
+  EXPECT_TRUE(detect_impacts(g, cache, params()).empty());
+  EXPECT_EQ(intersections(g, 0, 1), 0);
+  // The least mass-weighted correction: straight up to the projection gap, keeping the sideways motion.
+  for (int n = 0; n < g.meshes[0].node_end; ++n) {
+    EXPECT_NEAR(g.x1[n].z(), kH, 0.05 * kH);
+    EXPECT_NEAR(g.x1[n].x() - g.x0[n].x(), 0.003, 1e-9);
+  }
+}
+
+TEST(ImpactZones, TwoSheetsShareTheCorrectionByMass) {
+  // Sheet b falls through sheet a (at rest). Equal masses: both move, b stays above a.
+  Mesh a = sheet(3, 0.3, 0, 0, 1e-3), b = sheet(3, 0.2, 0.05, 0.05, 1e-3);
+  for (Node& n : a.nodes) n.x0 = n.x;
+  for (Node& n : b.nodes) {
+    n.x0 = n.x + Vec3(0, 0, 0.005);
+    n.x = n.x + Vec3(0, 0, -0.005);
+  }
+  ContactGeometry g;
+  build_contact_geometry({{&a, true}, {&b, true}}, ContactStage::kAfterStep, 1e-3, g);
+  BvhCache cache;
+  const ImpactZoneStats stats = resolve_impacts(g, cache, params());
+  EXPECT_TRUE(stats.resolved);
+  EXPECT_GT(stats.impacts, 0);
+  EXPECT_TRUE(detect_impacts(g, cache, params()).empty());
+  EXPECT_EQ(intersections(g, 0, 1), 0);
+  double lowest_b = kInfinity, moved_a = 0;
+  for (int n = g.meshes[1].node_begin; n < g.meshes[1].node_end; ++n) lowest_b = std::min(lowest_b, g.x1[n].z());
+  for (int n = 0; n < g.meshes[0].node_end; ++n) moved_a = std::min(moved_a, g.x1[n].z());
+  EXPECT_LT(moved_a, -1e-3);           // a was pushed down, not only b up
+  EXPECT_GT(lowest_b, moved_a + 0.5 * kH);
+}
+
+TEST(ImpactZones, HeavierSheetMovesLess) {
+  Mesh a = sheet(2, 0.3, 0, 0, 1e-1), b = sheet(2, 0.2, 0.05, 0.05, 1e-3);
+  for (Node& n : a.nodes) n.x0 = n.x;
+  for (Node& n : b.nodes) n.x0 = n.x + Vec3(0, 0, 0.002), n.x = n.x + Vec3(0, 0, -0.002);
+  ContactGeometry g;
+  build_contact_geometry({{&a, true}, {&b, true}}, ContactStage::kAfterStep, 1e-3, g);
+  BvhCache cache;
+  ASSERT_TRUE(resolve_impacts(g, cache, params()).resolved);
+  double down_a = 0, up_b = 0;
+  for (int n = 0; n < g.meshes[0].node_end; ++n) down_a = std::max(down_a, -g.x1[n].z());
+  for (int n = g.meshes[1].node_begin; n < g.meshes[1].node_end; ++n) up_b = std::max(up_b, g.x1[n].z() + 0.002);
+  EXPECT_LT(down_a, 0.05 * up_b);
+}
+
+TEST(ImpactZones, FlatSheetAlonePaysOnlyTheBroadPhase) {
+  Mesh s = sheet(20, 1, 0, 0, 1e-3);
+  for (Node& n : s.nodes) n.x0 = n.x, n.x += Vec3(0.01, -0.02, 0.03), n.v = Vec3(10, -20, 30);
+  ContactGeometry g;
+  build_contact_geometry({{&s, true}}, ContactStage::kAfterStep, 1e-3, g);
+  BvhCache cache;
+  EXPECT_TRUE(detect_impacts(g, cache, params()).empty());
+  const ImpactZoneStats stats = resolve_impacts(g, cache, params());
+  EXPECT_EQ(stats.iterations, 1);
+  EXPECT_EQ(stats.zones, 0);
+  build_contact_geometry({{&s, true}}, ContactStage::kBeforeStep, 1e-3, g);
+  ProximityParams p;
+  p.thickness = 1e-3;
+  EXPECT_TRUE(find_proximities(g, cache, p).empty());
+}
+
+TEST(ImpactZones, FloorPlaneStopsNodes) {
+  Mesh s = sheet(2, 0.2, 0, 0, 1e-3);
+  // Lay the sheet horizontally (y up) and drop it through y = 0 with no floor mesh at all.
+  for (Node& n : s.nodes) {
+    n.x = Vec3(n.x.x(), 0, n.x.y());
+    n.x0 = n.x + Vec3(0, 0.01, 0);
+    n.x += Vec3(0, -0.01, 0);
+  }
+  ContactGeometry g;
+  build_contact_geometry({{&s, true}}, ContactStage::kAfterStep, 1e-3, g);
+  ImpactZoneParams p = params();
+  p.floor = true;
+  p.floor_height = 0;
+  BvhCache cache;
+  EXPECT_TRUE(resolve_impacts(g, cache, p).resolved);
+  for (const Vec3& x : g.x1) EXPECT_NEAR(x.y(), kH, 0.05 * kH);
+}
+
+TEST(ImpactZones, InfeasibleZoneFallsBackWithWarning) {
+  // A small sheet between two static plates only half a projection gap apart falls through the lower one: no
+  // position satisfies both gaps, so the zone moves rigidly (still colliding) and then stays at x0.
+  Mesh s = sheet(1, 0.1, 0, 0, 1e-3), lower = plate(0), upper = plate(0.5 * kH);
+  for (Node& n : s.nodes) {
+    n.x0 = n.x + Vec3(0, 0, 0.25 * kH);
+    n.x = n.x + Vec3(0, 0, -0.01);
+  }
+  ContactGeometry g;
+  build_contact_geometry({{&s, true}, {&lower, false}, {&upper, false}}, ContactStage::kAfterStep, 1e-3, g);
+  ImpactZoneParams p = params();
+  p.max_iterations = 4;
+  p.step = 17;
+  BvhCache cache;
+  ::testing::internal::CaptureStderr();
+  const ImpactZoneStats stats = resolve_impacts(g, cache, p);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("step 17"), std::string::npos) << err;
+  EXPECT_NE(err.find("impact zone of 4 nodes"), std::string::npos) << err;
+  EXPECT_GE(stats.fallback_zones, 1);
+  EXPECT_TRUE(stats.resolved);
+  for (int n = 0; n < 4; ++n) EXPECT_EQ(g.x1[n], g.x0[n]);
+}
+
+}  // namespace
+}  // namespace arcsim

@@ -1,0 +1,163 @@
+// The impact-zone projection (NLopt) against closed forms and against an independent QP solver (Hildreth's
+// dual coordinate ascent), with both NLopt methods.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <random>
+
+#include "collision/zone_solver.hpp"
+
+namespace arcsim {
+namespace {
+
+constexpr double kGap = 1e-4;  // m
+
+ZoneConstraint make_constraint(std::array<int, 4> vars, std::array<double, 4> w, const Vec3& n, double fixed = 0) {
+  ZoneConstraint c;
+  c.vars = vars;
+  c.weights = w;
+  c.normal = n.normalized();
+  c.fixed_offset = fixed;
+  return c;
+}
+
+// Minimises sum m |x - x*|^2 subject to the constraints by coordinate ascent on the dual (exact for this QP in
+// the limit; run to convergence).
+std::vector<Vec3> hildreth(const ZoneProblem& p) {
+  std::vector<Vec3> x = p.target;
+  std::vector<double> lambda(p.constraints.size(), 0);
+  for (int sweep = 0; sweep < 20000; ++sweep) {
+    double change = 0;
+    for (size_t k = 0; k < p.constraints.size(); ++k) {
+      const ZoneConstraint& c = p.constraints[k];
+      double gap = c.fixed_offset, norm = 0;
+      for (int i = 0; i < 4; ++i) {
+        if (c.vars[i] == kNone) continue;
+        gap += c.weights[i] * c.normal.dot(x[c.vars[i]]);
+        norm += c.weights[i] * c.weights[i] / p.mass[c.vars[i]];
+      }
+      const double next = std::max(0.0, lambda[k] + (p.thickness - gap) / norm);
+      const double d = next - lambda[k];
+      lambda[k] = next;
+      for (int i = 0; i < 4; ++i)
+        if (c.vars[i] != kNone) x[c.vars[i]] += d * c.weights[i] / p.mass[c.vars[i]] * c.normal;
+      change = std::max(change, std::abs(d) * norm);
+    }
+    if (change < 1e-14 * p.thickness) break;
+  }
+  return x;
+}
+
+double max_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double d = 0;
+  for (size_t i = 0; i < a.size(); ++i) d = std::max(d, (a[i] - b[i]).norm());
+  return d;
+}
+
+TEST(ZoneSolver, SingleNodeAgainstFixedPlane) {
+  ZoneProblem p;
+  p.thickness = kGap;
+  p.target = {Vec3(0.1, 0.2, -1e-3)};
+  p.mass = {0.01};
+  // Gap = z of the node above a fixed point at z = 0.
+  p.constraints = {make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, Vec3::UnitZ())};
+  for (ZoneMethod method : {ZoneMethod::kSlsqp, ZoneMethod::kAugmentedLagrangian, ZoneMethod::kSparseAugmentedLagrangian}) {
+    std::vector<Vec3> x = p.target;
+    const ZoneResult r = solve_impact_zone(p, x, method);
+    EXPECT_TRUE(r.solved);
+    EXPECT_NEAR(x[0].z(), kGap, 2e-3 * kGap);
+    EXPECT_NEAR(x[0].x(), 0.1, 1e-3 * kGap);
+    EXPECT_NEAR(x[0].y(), 0.2, 1e-3 * kGap);
+  }
+}
+
+TEST(ZoneSolver, VertexFaceImpactMatchesClosedForm) {
+  // Vertex (mass 1) ends 2e-4 m below a face of three nodes (mass 2 each) at barycentrics (0.2, 0.3, 0.5).
+  ZoneProblem p;
+  p.thickness = kGap;
+  p.target = {Vec3(0.3, 0.4, -2e-4), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  p.mass = {1, 2, 2, 2};
+  const std::array<double, 4> w{1, -0.2, -0.3, -0.5};
+  p.constraints = {make_constraint({0, 1, 2, 3}, w, Vec3::UnitZ())};
+  // One active linear constraint a.x >= h: x = x* + lambda M^-1 a, lambda = (h - a.x*) / (a^T M^-1 a).
+  double ama = 0, gap = 0;
+  for (int i = 0; i < 4; ++i) ama += w[i] * w[i] / p.mass[i], gap += w[i] * p.target[i].z();
+  const double lambda = (kGap - gap) / ama;
+  for (ZoneMethod method : {ZoneMethod::kSlsqp, ZoneMethod::kAugmentedLagrangian, ZoneMethod::kSparseAugmentedLagrangian}) {
+    std::vector<Vec3> x = p.target;
+    ASSERT_TRUE(solve_impact_zone(p, x, method).solved);
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(x[i].z(), p.target[i].z() + lambda * w[i] / p.mass[i], 2e-3 * kGap);
+  }
+}
+
+TEST(ZoneSolver, SatisfiedConstraintsMoveNothing) {
+  ZoneProblem p;
+  p.thickness = kGap;
+  p.target = {Vec3(0, 0, 1)};
+  p.mass = {1};
+  p.constraints = {make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, Vec3::UnitZ())};
+  std::vector<Vec3> x = p.target;
+  ASSERT_TRUE(solve_impact_zone(p, x).solved);
+  EXPECT_LT((x[0] - p.target[0]).norm(), 1e-3 * kGap);
+}
+
+// A random zone: a chain of nodes with VF- and EE-like constraints between neighbours and some against fixed
+// geometry, all violated at the target.
+ZoneProblem random_zone(int nodes, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1), W(0.05, 1);
+  ZoneProblem p;
+  p.thickness = kGap;
+  for (int i = 0; i < nodes; ++i) {
+    p.target.push_back(Vec3(U(rng), U(rng), U(rng)) * 0.01);
+    p.mass.push_back(W(rng) * 1e-3);
+  }
+  for (int i = 0; i + 3 < nodes; ++i) {
+    const double b0 = W(rng), b1 = W(rng), b2 = W(rng), s = b0 + b1 + b2;
+    ZoneConstraint c = make_constraint({i, i + 1, i + 2, i + 3}, {1, -b0 / s, -b1 / s, -b2 / s},
+                                       Vec3(U(rng), U(rng), U(rng)));
+    // Violated by up to 3 thicknesses at the target.
+    double gap = 0;
+    for (int k = 0; k < 4; ++k) gap += c.weights[k] * c.normal.dot(p.target[c.vars[k]]);
+    c.fixed_offset = -gap + kGap * (1 - 4 * W(rng));
+    p.constraints.push_back(c);
+  }
+  for (int i = 0; i < nodes; i += 3) {
+    ZoneConstraint c = make_constraint({i, kNone, kNone, kNone}, {1, 0, 0, 0}, Vec3(U(rng), U(rng), 1));
+    c.fixed_offset = -c.normal.dot(p.target[i]) - kGap * W(rng);
+    p.constraints.push_back(c);
+  }
+  return p;
+}
+
+TEST(ZoneSolver, RandomZonesMatchIndependentQpSolver) {
+  for (int nodes : {4, 12, 24}) {
+    const ZoneProblem p = random_zone(nodes, 40 + nodes);
+    const std::vector<Vec3> expected = hildreth(p);
+    ASSERT_GE(worst_zone_gap(p, expected), kGap * (1 - 1e-6));
+    for (ZoneMethod method : {ZoneMethod::kSlsqp, ZoneMethod::kAugmentedLagrangian, ZoneMethod::kSparseAugmentedLagrangian}) {
+      std::vector<Vec3> x = p.target;
+      const ZoneResult r = solve_impact_zone(p, x, method);
+      EXPECT_TRUE(r.solved) << nodes << " nodes, method " << static_cast<int>(method);
+      EXPECT_GE(r.worst_gap, kGap * (1 - 2e-3));
+      EXPECT_LT(max_difference(x, expected), 2e-2 * kGap) << nodes << " nodes, method " << static_cast<int>(method);
+    }
+  }
+}
+
+TEST(ZoneSolver, InfeasibleZoneReportsFailure) {
+  // The node must be above +h and below -h of the same fixed point.
+  ZoneProblem p;
+  p.thickness = kGap;
+  p.target = {Vec3::Zero()};
+  p.mass = {1};
+  p.constraints = {make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, Vec3::UnitZ()),
+                   make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, -Vec3::UnitZ())};
+  std::vector<Vec3> x = p.target;
+  const ZoneResult r = solve_impact_zone(p, x);
+  EXPECT_FALSE(r.solved);
+  EXPECT_TRUE(x[0].allFinite());
+}
+
+}  // namespace
+}  // namespace arcsim
