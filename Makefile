@@ -89,8 +89,13 @@ TEST_ENV := ARCSIM_BIN=$(CURDIR)/bin/arcsim ARCSIM_SHARED=$(abspath $(CURDIR)/..
 check: deps
 	@$(MAKE) --no-print-directory check-release check-asan
 
+# Tests named *SlowCheck* (minutes-long runs of whole ARCSim scenes) run in `make slowcheck` only.
 check-release: bin/arcsim bin/arcsim-tests
-	$(TEST_ENV) OMP_NUM_THREADS=2 ./bin/arcsim-tests --gtest_brief=1
+	$(TEST_ENV) OMP_NUM_THREADS=2 ./bin/arcsim-tests --gtest_brief=1 --gtest_filter='-*SlowCheck*'
+
+slowcheck: deps
+	@$(MAKE) --no-print-directory bin/arcsim bin/arcsim-tests
+	$(TEST_ENV) OMP_NUM_THREADS=2 ./bin/arcsim-tests --gtest_filter='*SlowCheck*'
 
 # Sanitizer build: the whole suite except tests marked Slow (they run above, optimised).
 check-asan: bin/arcsim-asan bin/arcsim-tests-asan

@@ -25,7 +25,7 @@ std::string scene_path(const std::string& name) {
 
 class ArcsimRemeshScene : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(ArcsimRemeshScene, SlowRunsFiveSecondsWithRemeshing) {
+TEST_P(ArcsimRemeshScene, SlowCheckRunsFiveSecondsWithRemeshing) {
   const std::string path = scene_path(GetParam());
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "ARCSim example scenes not found at " << path;
   Scene scene = load_scene(path);
