@@ -1,7 +1,5 @@
 #include "app/resume_command.hpp"
 
-#include <omp.h>
-
 #include <filesystem>
 #include <system_error>
 
@@ -10,6 +8,7 @@
 #include "app/output.hpp"
 #include "app/output_files.hpp"
 #include "app/simulate_command.hpp"
+#include "app/threads.hpp"
 #include "io/errors.hpp"
 #include "io/scene_parser.hpp"
 #include "io/state.hpp"
@@ -86,7 +85,7 @@ int run_resume_command(const std::vector<std::string>& args, const Console& cons
   if (!fs::exists(state_path, ec))
     throw InputError(dir + ": frame " + std::to_string(frame) + " has no saved state (" + state_file_name(frame) +
                      ")");
-  if (options.threads > 0) omp_set_num_threads(options.threads);
+  configure_threads(options.threads);
 
   const Scene scene = load_scene((fs::path(dir) / kSceneCopyName).string());
   if (!options.quiet)

@@ -16,7 +16,7 @@ struct SimulateOptions {
   std::string out_dir;           // "" = dry run: simulate, write nothing
   double end_time = kInfinity;   // s; infinity keeps the scene's end
   double end_frame = kInfinity;  // frames; infinity keeps the scene's end
-  int threads = 0;               // OpenMP threads; 0 = OpenMP's default
+  int threads = 0;               // OpenMP threads; 0 = follow the free cores (app/threads.hpp)
   bool quiet = false;            // no warnings, no progress
   bool json_progress = false;    // --progress json: one JSON object per frame on stdout
   bool help = false;
