@@ -8,6 +8,9 @@ meshes/strip.obj        1 m x 0.1 m, 20 x 2 cells, 63 nodes, 80 faces; left end 
 meshes/square_notch.obj the square with a 90-degree V notch (0.1 m deep, 0.2 m wide) cut into the middle of the
                         left side, tip at (0.1, 0.5); 120 nodes, 198 faces; bottom side label 1, top side label 2
                         (for pulling the sheet apart across the notch).
+meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
+meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
+                        320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
 No `vt` lines: a flat sheet's rest shape is its initial world shape. Coordinates are in metres.
 """
 import os
@@ -88,6 +91,52 @@ def square_notch():
     return drop_node(nodes, faces, labels, cut_node)
 
 
+def ground():
+    nodes, faces, _ = grid(1.0, 1.0, 1, 1)
+    return nodes, faces, {}
+
+
+def icosphere(levels):
+    """Unit icosphere: the icosahedron's faces split in four `levels` times, new nodes pushed onto the sphere.
+    Returns 3D nodes and outward CCW faces."""
+    g = (1 + 5 ** 0.5) / 2
+    nodes = [(-1, g, 0), (1, g, 0), (-1, -g, 0), (1, -g, 0), (0, -1, g), (0, 1, g), (0, -1, -g), (0, 1, -g),
+             (g, 0, -1), (g, 0, 1), (-g, 0, -1), (-g, 0, 1)]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+             (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+
+    def unit(p):
+        length = sum(c * c for c in p) ** 0.5
+        return tuple(c / length for c in p)
+
+    nodes = [unit(p) for p in nodes]
+    for _ in range(levels):
+        middle = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in middle:
+                nodes.append(unit(tuple((p + q) / 2 for p, q in zip(nodes[a], nodes[b]))))
+                middle[key] = len(nodes) - 1
+            return middle[key]
+
+        split = []
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = split
+    return nodes, faces
+
+
+def write_obj_3d(path, comment, nodes, faces):
+    lines = ["# " + line for line in comment.splitlines()]
+    lines += ["v %.12g %.12g %.12g" % p for p in nodes]
+    lines += ["f %d %d %d" % (a + 1, b + 1, c + 1) for a, b, c in faces]
+    with open(path, "w") as out:
+        out.write("\n".join(lines) + "\n")
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "meshes")
@@ -100,6 +149,10 @@ def main():
     write_obj(os.path.join(out_dir, "square_notch.obj"),
               "1 m x 1 m sheet with a V notch (tip at 0.1 0.5) in the left side; bottom label 1, top label 2\n" +
               generated, *square_notch())
+    write_obj(os.path.join(out_dir, "ground.obj"),
+              "1 m x 1 m flat sheet, one cell (a floor obstacle)\n" + generated, *ground())
+    write_obj_3d(os.path.join(out_dir, "sphere.obj"),
+                 "unit sphere, icosahedron subdivided twice, outward faces\n" + generated, *icosphere(2))
 
 
 if __name__ == "__main__":

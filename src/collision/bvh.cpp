@@ -71,6 +71,23 @@ struct BvhTraversal {
   const Bvh& A;
   const Bvh& B;
   bool same_tree;
+  // Per tree node: the subtree holds a dirty primitive (empty: everything is dirty).
+  std::vector<char> dirty_a, dirty_b;
+
+  static std::vector<char> subtree_flags(const Bvh& t, const std::vector<char>* primitives) {
+    if (!primitives) return {};
+    std::vector<char> flags(t.nodes_.size(), 0);
+    for (int i = static_cast<int>(t.nodes_.size()) - 1; i >= 0; --i) {
+      const Bvh::Node& n = t.nodes_[i];
+      flags[i] = n.leaf() ? (*primitives)[n.primitive] : (flags[n.left] || flags[n.right]);
+    }
+    return flags;
+  }
+  bool any_dirty(int a, int b) const {
+    const bool da = dirty_a.empty() || dirty_a[a];
+    const bool db = same_tree ? (dirty_a.empty() || dirty_a[b]) : (dirty_b.empty() || dirty_b[b]);
+    return da || db;
+  }
 
   struct Item {
     int a, b;
@@ -79,7 +96,7 @@ struct BvhTraversal {
 
   void self_pairs(int a, std::vector<std::pair<int, int>>& out) const {
     const Bvh::Node& n = A.nodes_[a];
-    if (n.leaf()) return;
+    if (n.leaf() || !any_dirty(a, a)) return;
     self_pairs(n.left, out);
     self_pairs(n.right, out);
     cross_pairs(n.left, n.right, out);
@@ -88,7 +105,7 @@ struct BvhTraversal {
   void cross_pairs(int a, int b, std::vector<std::pair<int, int>>& out) const {
     const Bvh::Node& na = A.nodes_[a];
     const Bvh::Node& nb = B.nodes_[b];
-    if (!na.box.overlaps(nb.box)) return;
+    if (!na.box.overlaps(nb.box) || !any_dirty(a, b)) return;
     if (na.leaf() && nb.leaf()) {
       int i = na.primitive, j = nb.primitive;
       if (same_tree && i > j) std::swap(i, j);
@@ -163,19 +180,25 @@ struct BvhTraversal {
     for (const auto& f : found) total += f.size();
     pairs.reserve(total);
     for (const auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
-    std::sort(pairs.begin(), pairs.end());
     return pairs;
   }
 };
 
-std::vector<std::pair<int, int>> Bvh::self_overlaps() const {
+std::vector<std::pair<int, int>> Bvh::self_overlaps(const std::vector<char>* dirty) const {
   if (nodes_.empty()) return {};
-  return BvhTraversal{*this, *this, true}.run({0, 0, true});
+  return BvhTraversal{*this, *this, true, BvhTraversal::subtree_flags(*this, dirty), {}}.run({0, 0, true});
 }
 
-std::vector<std::pair<int, int>> Bvh::overlaps(const Bvh& other) const {
+std::vector<std::pair<int, int>> Bvh::overlaps(const Bvh& other, const std::vector<char>* dirty,
+                                               const std::vector<char>* other_dirty) const {
   if (nodes_.empty() || other.nodes_.empty()) return {};
-  return BvhTraversal{*this, other, false}.run({0, 0, false});
+  // A clean side (no flags given while the other has them) counts as clean everywhere.
+  std::vector<char> clean_a, clean_b;
+  if (other_dirty && !dirty) clean_a.assign(primitive_count(), 0), dirty = &clean_a;
+  if (dirty && !other_dirty) clean_b.assign(other.primitive_count(), 0), other_dirty = &clean_b;
+  return BvhTraversal{*this, other, false, BvhTraversal::subtree_flags(*this, dirty),
+                      BvhTraversal::subtree_flags(other, other_dirty)}
+      .run({0, 0, false});
 }
 
 }  // namespace arcsim

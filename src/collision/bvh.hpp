@@ -1,7 +1,8 @@
 // Bounding-volume hierarchy of axis-aligned boxes over the triangles of one mesh: built once per topology
 // (median splits), refitted bottom-up whenever the boxes move, and traversed against itself or another tree
-// to list the primitive pairs whose boxes overlap. Traversals run in parallel (OpenMP) and return their pairs
-// sorted, so the result does not depend on the thread count. Cost: the tree size plus the overlapping pairs.
+// to list the primitive pairs whose boxes overlap. Large traversals run in parallel (OpenMP); the pairs come in
+// a deterministic order for a given thread count (callers that need more sort them: find_candidates does).
+// Cost: the tree size plus the overlapping pairs.
 #pragma once
 
 #include <utility>
@@ -21,10 +22,12 @@ class Bvh {
   bool empty() const { return nodes_.empty(); }
   const Aabb& bounds() const { return nodes_.front().box; }
 
-  // Pairs (i, j), i < j, of primitives whose boxes overlap.
-  std::vector<std::pair<int, int>> self_overlaps() const;
-  // Pairs (i of this tree, j of `other`) whose boxes overlap.
-  std::vector<std::pair<int, int>> overlaps(const Bvh& other) const;
+  // Pairs (i, j), i < j, of primitives whose boxes overlap. With `dirty` (a flag per primitive), only pairs
+  // with at least one dirty primitive, pruning clean subtrees (cost then follows the dirty part).
+  std::vector<std::pair<int, int>> self_overlaps(const std::vector<char>* dirty = nullptr) const;
+  // Pairs (i of this tree, j of `other`) whose boxes overlap; with flags, only pairs with a dirty member.
+  std::vector<std::pair<int, int>> overlaps(const Bvh& other, const std::vector<char>* dirty = nullptr,
+                                            const std::vector<char>* other_dirty = nullptr) const;
 
  private:
   struct Node {

@@ -71,6 +71,15 @@ class CandidateFinder {
     return boxes;
   }
 
+  // Per face of mesh range r: has a moved node (only with options.moved).
+  std::vector<char> moved_faces(const ContactGeometry::Range& r) const {
+    std::vector<char> flags(r.face_end - r.face_begin, 0);
+    for (int f = r.face_begin; f < r.face_end; ++f)
+      if (g_.faces[f][0] != kNone)
+        for (int n : g_.faces[f]) flags[f - r.face_begin] |= (*options_.moved)[n];
+    return flags;
+  }
+
   // Primitive pairs of the face pair (fa, fb), fa != fb.
   void face_pair(int fa, int fb, std::vector<PrimitivePair>& out) const {
     vertices_against_face(fa, fb, out);
@@ -80,6 +89,7 @@ class CandidateFinder {
       const Aabb box_a = edge_box(ea);
       for (int l = g_.owned_edge_begin[fb]; l < g_.owned_edge_begin[fb + 1]; ++l) {
         const int eb = g_.owned_edges[l];
+        if (!any_moved(g_.edges[ea]) && !any_moved(g_.edges[eb])) continue;
         if (share_node(g_.edges[ea], g_.edges[eb]) || !box_a.overlaps(edge_box(eb))) continue;
         out.push_back({PairKind::kEdgeEdge, std::min(ea, eb), std::max(ea, eb)});
       }
@@ -104,10 +114,16 @@ class CandidateFinder {
     return b;
   }
 
+  bool moved(int n) const { return !options_.moved || (*options_.moved)[n]; }
+  bool any_moved(const std::array<int, 2>& e) const { return moved(e[0]) || moved(e[1]); }
+  bool any_moved(const std::array<int, 3>& f) const { return moved(f[0]) || moved(f[1]) || moved(f[2]); }
+
   void vertices_against_face(int owner, int face, std::vector<PrimitivePair>& out) const {
     const Aabb box = face_box(face);
+    const bool face_moved = any_moved(g_.faces[face]);
     for (int k = g_.owned_node_begin[owner]; k < g_.owned_node_begin[owner + 1]; ++k) {
       const int n = g_.owned_nodes[k];
+      if (!face_moved && !moved(n)) continue;
       if (contains(g_.faces[face], n) || !node_box_[n].overlaps(box)) continue;
       out.push_back({PairKind::kVertexFace, n, face});
     }
@@ -119,6 +135,7 @@ class CandidateFinder {
       if (!on_boundary_[n]) continue;
       for (int l = g_.owned_edge_begin[face]; l < g_.owned_edge_begin[face + 1]; ++l) {
         const int e = g_.owned_edges[l];
+        if (!moved(n) && !any_moved(g_.edges[e])) continue;
         if (!g_.is_boundary_edge(e) || g_.edges[e][0] == n || g_.edges[e][1] == n) continue;
         if (!node_box_[n].overlaps(edge_box(e))) continue;
         out.push_back({PairKind::kVertexEdge, n, e});
@@ -142,15 +159,24 @@ std::vector<PrimitivePair> find_candidates(const ContactGeometry& g, BvhCache& c
   // Face pairs as global indices, mesh pair by mesh pair.
   std::vector<std::pair<int, int>> face_pairs;
   const int meshes = static_cast<int>(g.meshes.size());
+  std::vector<std::vector<char>> moved(meshes);
+  std::vector<char> any_moved(meshes, 1);
+  if (options.moved) {
+    for (int i = 0; i < meshes; ++i) {
+      moved[i] = finder.moved_faces(g.meshes[i]);
+      any_moved[i] = std::find(moved[i].begin(), moved[i].end(), 1) != moved[i].end();
+    }
+  }
+  auto flags = [&](int i) { return options.moved ? &moved[i] : nullptr; };
   for (int i = 0; i < meshes; ++i) {
     const auto& ri = g.meshes[i];
-    if (ri.deformable)
-      for (const auto& p : cache.tree(i).self_overlaps())
+    if (ri.deformable && any_moved[i])
+      for (const auto& p : cache.tree(i).self_overlaps(flags(i)))
         face_pairs.emplace_back(ri.face_begin + p.first, ri.face_begin + p.second);
     for (int j = i + 1; j < meshes; ++j) {
       const auto& rj = g.meshes[j];
-      if (!ri.deformable && !rj.deformable) continue;
-      for (const auto& p : cache.tree(i).overlaps(cache.tree(j)))
+      if ((!ri.deformable && !rj.deformable) || (!any_moved[i] && !any_moved[j])) continue;
+      for (const auto& p : cache.tree(i).overlaps(cache.tree(j), flags(i), flags(j)))
         face_pairs.emplace_back(ri.face_begin + p.first, rj.face_begin + p.second);
     }
   }

@@ -44,6 +44,9 @@ struct CandidateOptions {
   double margin = 0;         // pairs closer than this (m) are found (boxes grow by margin / 2)
   bool swept = false;        // boxes cover the motion x0 -> x1 (else the positions x0 only)
   bool vertex_edge = false;  // also boundary vertex vs boundary edge of deformable meshes
+  // Optional flag per node: only pairs with at least one flagged node are wanted (e.g. the nodes an impact
+  // zone moved since the last search); the traversal then skips subtrees without flagged nodes.
+  const std::vector<char>* moved = nullptr;
 };
 
 // Candidate pairs, sorted (deterministic whatever the thread count).

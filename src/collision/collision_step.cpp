@@ -18,6 +18,16 @@ double contact_distance(const CollisionSettings& s) { return std::min(1e-6, 0.1 
 
 }  // namespace
 
+void ImpactZoneTotals::add(const ImpactZoneStats& s) {
+  ++steps;
+  impacts += s.impacts;
+  zones += s.zones;
+  iterations += s.iterations;
+  largest_zone = std::max(largest_zone, s.largest_zone);
+  fallback_zones += s.fallback_zones;
+  unresolved_steps += !s.resolved;
+}
+
 std::vector<std::vector<ContactTerm>> CollisionHandler::proximity_terms(const std::vector<const Mesh*>& cloths,
                                                                         const std::vector<const Mesh*>& obstacles,
                                                                         const CollisionSettings& settings,
@@ -51,6 +61,7 @@ ImpactZoneStats CollisionHandler::resolve_collisions(const std::vector<Mesh*>& c
   params.floor_height = settings.floor_height;
   params.step = settings.step;
   const ImpactZoneStats stats = resolve_impacts(geometry_, cache_, params);
+  totals_.add(stats);
 
   for (size_t c = 0; c < cloths.size(); ++c) {
     Mesh& mesh = *cloths[c];

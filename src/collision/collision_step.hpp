@@ -25,6 +25,18 @@ struct CollisionSettings {
   int step = 0;                        // for messages
 };
 
+// Impact-zone work summed over the steps since the totals were last cleared (for the run's log).
+struct ImpactZoneTotals {
+  int steps = 0;             // steps with a collision response
+  long long impacts = 0;     // impacts found in the steps' first detection rounds
+  long long zones = 0;       // zones at the ends of the steps
+  long long iterations = 0;  // detection rounds
+  int largest_zone = 0;      // nodes, largest over the steps
+  int fallback_zones = 0;    // zones moved rigidly or held at their start positions
+  int unresolved_steps = 0;  // steps whose motion could not be made collision free
+  void add(const ImpactZoneStats& s);
+};
+
 class CollisionHandler {
  public:
   // Contact terms for each cloth (in the order given) at the start of the step: cloths at x moving with v,
@@ -39,8 +51,11 @@ class CollisionHandler {
                                      const CollisionSettings& settings, double dt);
 
   const BvhCache& bvh_cache() const { return cache_; }
+  const ImpactZoneTotals& totals() const { return totals_; }
+  void clear_totals() { totals_ = ImpactZoneTotals(); }
 
  private:
+  ImpactZoneTotals totals_;
   BvhCache cache_;
   ContactGeometry geometry_;
 };

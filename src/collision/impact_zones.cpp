@@ -7,11 +7,12 @@
 
 namespace arcsim {
 
-std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache,
-                                         const ImpactZoneParams& params) {
+std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params,
+                                         const std::vector<char>* moved) {
   CandidateOptions options;
   options.margin = params.contact_distance;
   options.swept = true;
+  options.moved = moved;
   const std::vector<PrimitivePair> pairs = find_candidates(g, cache, options);
   CcdOptions ccd;
   ccd.contact_distance = params.contact_distance;
@@ -48,6 +49,7 @@ std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cac
     for (const auto& r : g.meshes) {
       if (!r.deformable) continue;
       for (int n = r.node_begin; n < r.node_end; ++n) {
+        if (moved && !(*moved)[n]) continue;
         const double h0 = g.x0[n].y() - params.floor_height, h1 = g.x1[n].y() - params.floor_height;
         if (!(h0 >= -params.contact_distance) || !(h1 < params.contact_distance)) continue;
         ImpactRecord rec;
@@ -214,9 +216,16 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
     return stats;
   };
 
-  // Projection rounds.
+  // Projection rounds. After the first, only pairs involving nodes of the zones just moved can have changed:
+  // every other pair kept its motion and was collision free (or it would be in a zone).
+  std::vector<char> moved;
+  auto mark_moved = [&](const std::vector<Zone*>& changed) {
+    moved.assign(g.node_count(), 0);
+    for (const Zone* z : changed)
+      for (int n : z->nodes) moved[n] = 1;
+  };
   for (int iteration = 0; iteration <= params.max_iterations; ++iteration) {
-    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params);
+    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, iteration ? &moved : nullptr);
     stats.iterations = iteration + 1;
     if (iteration == 0) stats.impacts = static_cast<int>(impacts.size());
     if (impacts.empty()) return finish(true);
@@ -237,14 +246,15 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       project_zone(*dirty[k], target, g, params);
       dirty[k]->dirty = false;
     }
+    mark_moved(dirty);
   }
 
   // Fallback rounds: zones still colliding move rigidly, then (if that collides too) stay at x0.
   for (int round = 0; round < params.max_fallback_iterations; ++round) {
-    bool any = false;
+    std::vector<Zone*> changed;
     for (Zone& z : zones.zones()) {
       if (!z.alive || !z.dirty) continue;
-      any = true;
+      changed.push_back(&z);
       z.dirty = false;
       if (z.state == ZoneState::kProjected) {
         z.state = ZoneState::kRigid;
@@ -261,8 +271,9 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       }
       move_rigidly(z, target, g);
     }
-    if (!any) break;
-    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params);
+    if (changed.empty()) break;
+    mark_moved(changed);
+    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, &moved);
     ++stats.iterations;
     if (impacts.empty()) return finish(true);
     zones.add(impacts);

@@ -40,8 +40,9 @@ struct ImpactRecord {
 constexpr int kFloorImpact = 3;
 
 // Every impact of the motion x0 -> x1 of the geometry (at most one per primitive pair: the first), in a
-// deterministic order.
-std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params);
+// deterministic order. With `moved` (a flag per node), only impacts involving a flagged node.
+std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params,
+                                         const std::vector<char>* moved = nullptr);
 
 struct ImpactZoneStats {
   int iterations = 0;        // detection rounds

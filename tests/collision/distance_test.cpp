@@ -2,7 +2,9 @@
 // primitives' parameters (zooming grids), on random and degenerate configurations.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <random>
 
 #include "collision/distance.hpp"
@@ -158,6 +160,33 @@ TEST(Distance, VertexEdge) {
   r = vertex_edge_closest(Vec3(-1, 0, 0), Vec3(0, 0, 0), Vec3(1, 0, 0));
   EXPECT_NEAR(r.distance, 1.0, 1e-15);
   EXPECT_EQ(r.weights[2], 0.0);
+}
+
+TEST(Distance, VertexEdgeMatchesBruteForceOnRandomAndDegeneratePairs) {
+  // Brute force: the segment parameter on a zooming grid (the second grid parameter is unused).
+  auto brute = [](const Vec3& p, const Vec3& a, const Vec3& b) {
+    return grid_minimum([&](double s, double) { return (p - (a + s * (b - a))).norm(); },
+                        [](const Vec2& q) { return Vec2(std::clamp(q.x(), 0.0, 1.0), 0.0); });
+  };
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::vector<std::array<Vec3, 3>> cases;
+  for (int k = 0; k < 30; ++k) cases.push_back({Vec3(U(rng), U(rng), U(rng)), Vec3(U(rng), U(rng), U(rng)),
+                                                Vec3(U(rng), U(rng), U(rng))});
+  // Degenerate: vertex on the segment, on its line beyond an end, zero-length segment, vertex at an end.
+  cases.push_back({Vec3(0.25, 0.5, 0), Vec3(0, 0, 0), Vec3(0.5, 1, 0)});
+  cases.push_back({Vec3(2, 4, 0), Vec3(0, 0, 0), Vec3(0.5, 1, 0)});
+  cases.push_back({Vec3(1, 2, 3), Vec3(0.5, 0.5, 0.5), Vec3(0.5, 0.5, 0.5)});
+  cases.push_back({Vec3(0.5, 1, 0), Vec3(0, 0, 0), Vec3(0.5, 1, 0)});
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const auto& [p, a, b] = cases[k];
+    const ClosestPoints r = vertex_edge_closest(p, a, b);
+    expect_consistent(r, {p, a, b, Vec3::Zero()});
+    EXPECT_EQ(r.weights[3], 0.0);
+    const double expected = brute(p, a, b);
+    EXPECT_LE(r.distance, expected + 1e-12) << "case " << k;
+    EXPECT_GE(r.distance, expected - 1e-7) << "case " << k;
+  }
 }
 
 }  // namespace

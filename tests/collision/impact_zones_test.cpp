@@ -3,6 +3,7 @@
 // correction, and an infeasible zone falls back to rigid motion / staying put with a warning.
 #include <gtest/gtest.h>
 
+#include "collision/collision_step.hpp"
 #include "collision/impact_zones.hpp"
 #include "collision/proximity.hpp"
 #include "collision/tri_tri.hpp"
@@ -66,6 +67,34 @@ TEST(ImpactZones, SheetPassingThroughPlateStopsAtTheGap) {
     EXPECT_NEAR(g.x1[n].z(), kH, 0.05 * kH);
     EXPECT_NEAR(g.x1[n].x() - g.x0[n].x(), 0.003, 1e-9);
   }
+}
+
+TEST(ImpactZones, HandlerSumsZoneStatisticsOverSteps) {
+  // The same tunnelling sheet through the CollisionHandler, twice: the totals add both steps' statistics.
+  Mesh p = plate(0);
+  CollisionHandler handler;
+  CollisionSettings settings;
+  settings.projection_thickness = kH;
+  for (int step = 0; step < 2; ++step) {
+    Mesh s = sheet(4, 0.2, 0.1, 0.15, 1e-3);
+    for (Node& n : s.nodes) {
+      n.x0 = n.x + Vec3(0, 0, 0.01);
+      n.x = n.x + Vec3(0, 0, -0.01);
+    }
+    const ImpactZoneStats stats = handler.resolve_collisions({&s}, {&p}, settings, 1e-3);
+    EXPECT_TRUE(stats.resolved);
+    EXPECT_EQ(handler.totals().steps, step + 1);
+    EXPECT_EQ(handler.totals().impacts, (step + 1) * static_cast<long long>(stats.impacts));
+    EXPECT_EQ(handler.totals().zones, (step + 1) * static_cast<long long>(stats.zones));
+    EXPECT_GE(stats.zones, 1);
+    EXPECT_GT(stats.impacts, 0);
+    EXPECT_EQ(handler.totals().largest_zone, stats.largest_zone);
+    EXPECT_EQ(handler.totals().unresolved_steps, 0);
+    for (const Node& n : s.nodes) EXPECT_NEAR(n.x.z(), kH, 0.05 * kH);
+  }
+  handler.clear_totals();
+  EXPECT_EQ(handler.totals().steps, 0);
+  EXPECT_EQ(handler.totals().impacts, 0);
 }
 
 TEST(ImpactZones, TwoSheetsShareTheCorrectionByMass) {
