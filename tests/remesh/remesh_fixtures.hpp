@@ -65,14 +65,14 @@ inline Mesh make_icosphere(double radius, int levels) {
   return mesh_from(p, tris);
 }
 
-// Upper hemisphere (z >= 0) of `radius` about the origin: a hexagonal disk of `rings` rings (6 i nodes on ring
-// i) mapped to polar angle (pi/2) i / rings.
-inline Mesh make_hemisphere(double radius, int rings) {
+// Spherical cap of `radius` about the origin around +z, up to polar angle `polar_max` (rad): a hexagonal disk of
+// `rings` rings (6 i nodes on ring i) mapped to polar angle polar_max i / rings.
+inline Mesh make_spherical_cap(double radius, double polar_max, int rings) {
   std::vector<Vec3> p{Vec3(0, 0, radius)};
   std::vector<int> ring_start{0};
   for (int i = 1; i <= rings; ++i) {
     ring_start.push_back(static_cast<int>(p.size()));
-    const double polar = 0.5 * kPi * i / rings;
+    const double polar = polar_max * i / rings;
     for (int k = 0; k < 6 * i; ++k) {
       const double azimuth = 2 * kPi * k / (6 * i);
       p.emplace_back(radius * std::sin(polar) * std::cos(azimuth), radius * std::sin(polar) * std::sin(azimuth),
@@ -86,13 +86,17 @@ inline Mesh make_hemisphere(double radius, int rings) {
   std::vector<std::array<int, 3>> tris;
   for (int i = 1; i <= rings; ++i)
     for (int s = 0; s < 6; ++s) {
-      for (int k = 0; k < i; ++k) tris.push_back({node(i - 1, s * (i - 1) + k), node(i, s * i + k), node(i, s * i + k + 1)});
+      for (int k = 0; k < i; ++k)
+        tris.push_back({node(i - 1, s * (i - 1) + k), node(i, s * i + k), node(i, s * i + k + 1)});
       for (int k = 0; k + 1 < i; ++k)
         tris.push_back({node(i - 1, s * (i - 1) + k), node(i, s * i + k + 1), node(i - 1, s * (i - 1) + k + 1)});
     }
   orient(tris, p, [](const Vec3& c) { return c; });
   return mesh_from(p, tris);
 }
+
+// Upper hemisphere (z >= 0) of `radius` about the origin, `rings` rings from the pole to the equator.
+inline Mesh make_hemisphere(double radius, int rings) { return make_spherical_cap(radius, 0.5 * kPi, rings); }
 
 // Open tube of `radius` about the z axis over z in [0, length]: `around` nodes per ring, `rings` + 1 rings.
 inline Mesh make_cylinder(double radius, double length, int around, int rings) {
@@ -159,6 +163,20 @@ inline double rest_volume(const Mesh& m) {
   double v = 0;
   for (const Face& f : m.faces)
     if (!f.dead) v += m.verts[f.v[0]].u.dot(m.verts[f.v[1]].u.cross(m.verts[f.v[2]].u)) / 6;
+  return v;
+}
+
+// Volume enclosed by a rest tube about the z axis between the planes of its ends (m^3): the flux of
+// (x, y, 0) / 2, whose divergence is 1, through the faces (the flat end caps add none). Exact per face with the
+// centroid, as the field is linear.
+inline double rest_volume_about_z(const Mesh& m) {
+  double v = 0;
+  for (const Face& f : m.faces) {
+    if (f.dead) continue;
+    const Vec3 &u0 = m.verts[f.v[0]].u, &u1 = m.verts[f.v[1]].u, &u2 = m.verts[f.v[2]].u;
+    const Vec3 c = (u0 + u1 + u2) / 3;
+    v += (u1 - u0).cross(u2 - u0).dot(Vec3(c.x(), c.y(), 0)) / 4;
+  }
   return v;
 }
 

@@ -199,7 +199,8 @@ TEST(Remesh, RefinesWhereTheSheetBends) {
   EXPECT_GT(flat_sum / flat_count, 0.1);
   EXPECT_LT(bend_sum / bend_count, 0.05);
   double max_angle = 0;
-  for (size_t e = 0; e < m.edges.size(); ++e) max_angle = std::max(max_angle, std::abs(m.world_dihedral(static_cast<int>(e))));
+  for (size_t e = 0; e < m.edges.size(); ++e)
+    max_angle = std::max(max_angle, std::abs(m.world_dihedral(static_cast<int>(e))));
   EXPECT_LT(max_angle, 0.12);
 }
 
