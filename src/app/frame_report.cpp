@@ -1,5 +1,7 @@
 #include "app/frame_report.hpp"
 
+#include <string>
+
 #include "app/json_line.hpp"
 
 namespace arcsim {
@@ -21,6 +23,40 @@ std::string frame_log_line(const FrameReport& r) {
       .integer("faces", r.faces)
       .boolean("saved", r.saved)
       .object("wall", wall);
+  if (!r.plastic_work.empty()) {
+    JsonLine work;
+    double total = 0;
+    for (double w : r.plastic_work) total += w;
+    work.number("total", total);
+    for (size_t c = 0; c < r.plastic_work.size(); ++c)
+      work.number(("cloth" + std::to_string(c)).c_str(), r.plastic_work[c]);
+    line.object("plastic_work", work);
+  }
+  if (!r.meshes.empty()) {
+    JsonLine meshes;
+    for (size_t c = 0; c < r.meshes.size(); ++c) {
+      const ClothMeshReport& m = r.meshes[c];
+      JsonLine mesh;
+      mesh.integer("faces", m.faces)
+          .number("edge_min", m.edge_min)
+          .number("edge_median", m.edge_median)
+          .number("edge_max", m.edge_max);
+      meshes.object(("cloth" + std::to_string(c)).c_str(), mesh);
+    }
+    line.object("meshes", meshes);
+  }
+  if (r.has_impact_zones) {
+    const ImpactZoneTotals& z = r.impact_zones;
+    JsonLine zones;
+    zones.integer("steps", z.steps)
+        .integer("impacts", z.impacts)
+        .integer("zones", z.zones)
+        .integer("iterations", z.iterations)
+        .integer("largest_zone", z.largest_zone)
+        .integer("fallback_zones", z.fallback_zones)
+        .integer("unresolved_steps", z.unresolved_steps);
+    line.object("impact_zones", zones);
+  }
   return line.str();
 }
 

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include "collision/collision_step.hpp"  // ImpactZoneTotals
 
 namespace arcsim {
 
@@ -9,6 +12,12 @@ namespace arcsim {
 struct FrameWallTimes {
   double physics = 0, collision = 0, remeshing = 0, plasticity = 0, fracture = 0, output = 0;
   double total = 0;  // the whole frame: stepping and output
+};
+
+// Mesh size of one cloth at the end of a frame (remesh/remesh_cloth.hpp's mesh_size_stats).
+struct ClothMeshReport {
+  long long faces = 0;
+  double edge_min = 0, edge_median = 0, edge_max = 0;  // world edge lengths (m)
 };
 
 struct FrameReport {
@@ -19,9 +28,17 @@ struct FrameReport {
   long long faces = 0;
   bool saved = false;     // frame files were written for it
   FrameWallTimes wall;
+  std::vector<ClothMeshReport> meshes;  // per cloth, in scene order
+  std::vector<double> plastic_work;  // J per cloth over the frame's steps; empty when plasticity is off
+  bool has_impact_zones = false;     // the collision module ran: impact_zones below is meaningful
+  ImpactZoneTotals impact_zones;     // summed over the frame's steps
 };
 
-// {"frame":..,"time":..,"steps":..,"nodes":..,"faces":..,"saved":..,"wall":{"physics":..,...,"total":..}}
+// {"frame":..,"time":..,"steps":..,"nodes":..,"faces":..,"saved":..,"wall":{"physics":..,...,"total":..}}, then
+// "plastic_work":{"total":..,"cloth0":..,...} (J) when plastic_work is not empty, then
+// "meshes":{"cloth0":{"faces":..,"edge_min":..,"edge_median":..,"edge_max":..},...} (m) when meshes is not empty,
+// then "impact_zones":{"steps":..,"impacts":..,"zones":..,"iterations":..,"largest_zone":..,"fallback_zones":..,
+// "unresolved_steps":..} when has_impact_zones.
 std::string frame_log_line(const FrameReport& report);
 
 // {"frame":..,"total":..,"time":..,"faces":..,"nodes":..,"wall":..}; total is null when the run is unbounded,

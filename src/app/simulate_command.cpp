@@ -1,7 +1,5 @@
 #include "app/simulate_command.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,8 +10,10 @@
 #include "app/frame_report.hpp"
 #include "app/output.hpp"
 #include "app/progress.hpp"
+#include "app/threads.hpp"
 #include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "remesh/remesh_cloth.hpp"
 #include "sim/simulation.hpp"
 
 namespace arcsim {
@@ -30,7 +30,7 @@ const char kSimulateHelp[] =
     "Options (anywhere after the command):\n"
     "  --end-time T      stop at simulated time T seconds (overrides the scene's end)\n"
     "  --end-frame N     stop after frame N (overrides the scene's end)\n"
-    "  --threads N       use N OpenMP threads\n"
+    "  --threads N       use exactly N threads (default: the cores left free by other processes)\n"
     "  --quiet           print no warnings and no progress (errors only)\n"
     "  --progress json   print one JSON object per frame on stdout (frame, total, time, faces, nodes, wall)\n"
     "  --help, -h        show this help\n"
@@ -48,9 +48,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 void count_elements(const Simulation& sim, FrameReport& report) {
   report.nodes = report.faces = 0;
+  report.meshes.clear();
   for (const Cloth& c : sim.cloths) {
     report.nodes += static_cast<long long>(c.mesh.nodes.size());
     report.faces += static_cast<long long>(c.mesh.faces.size());
+    const MeshSizeStats s = mesh_size_stats(c.mesh);
+    report.meshes.push_back({s.faces, s.edge_min, s.edge_median, s.edge_max});
   }
 }
 
@@ -102,7 +105,7 @@ SimulateOptions parse_simulate_options(const std::vector<std::string>& args) {
 }
 
 int run_simulate(const SimulateOptions& options, const Console& console) {
-  if (options.threads > 0) omp_set_num_threads(options.threads);
+  configure_threads(options.threads);
 
   const Scene scene = load_scene(options.scene);
   const auto warn = [&](const std::vector<std::string>& warnings) {
@@ -140,6 +143,9 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   report.time = sim.time();
   count_elements(sim, report);
   copy_module_times(sim.times, report.wall);
+  if (sim.scene().enabled("plasticity")) report.plastic_work = sim.plastic_work;
+  report.has_impact_zones = sim.scene().enabled("collision");
+  report.impact_zones = sim.collision_totals();
 }
 
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {
@@ -150,6 +156,7 @@ void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& optio
   try {
     while (!sim.finished()) {
       sim.times.clear();
+      sim.clear_collision_totals();
       const int first_step = sim.step();
       const auto frame_start = std::chrono::steady_clock::now();
       sim.advance_frame();

@@ -724,6 +724,13 @@ class SceneParser {
     const Found fracture = r.get("refine_fracture");
     p.has_refine_fracture = bool(fracture);
     p.refine_fracture = get_real(fracture, kInfinity, kNonNegative);
+    // How plastic state follows remeshing edits (plasticity/plastic_embedding.hpp).
+    if (const Found transfer = r.get("plastic_transfer")) {
+      const std::string mode = to_string(*transfer.value, transfer.at);
+      if (mode != "embedding" && mode != "interpolate")
+        fail(transfer.at, "must be \"embedding\" or \"interpolate\", got \"" + mode + "\"");
+      p.plastic_embedding = mode == "embedding";
+    }
     r.warn_unknown();
     return p;
   }

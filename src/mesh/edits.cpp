@@ -288,10 +288,11 @@ EditResult flip_edge(Mesh& m, int edge) {
   const double w0 = 0.5 * normal0.norm(), w1 = 0.5 * normal1.norm();
   const double s0 = w0 / (w0 + w1), s1 = w1 / (w0 + w1);
   Face proto = prototype_of(F0);
-  proto.thickness = s0 * F0.thickness + s1 * F1.thickness;
-  proto.Fp = s0 * F0.Fp + s1 * F1.Fp;
-  proto.Sp = s0 * F0.Sp + s1 * F1.Sp;
-  proto.damage = s0 * F0.damage + s1 * F1.damage;
+  // Equal states stay exact (s0 + s1 rounds off 1): an elastic face's Fp = I and Sp = 0 must not drift.
+  proto.thickness = F0.thickness == F1.thickness ? F0.thickness : s0 * F0.thickness + s1 * F1.thickness;
+  proto.Fp = F0.Fp == F1.Fp ? F0.Fp : Mat3(s0 * F0.Fp + s1 * F1.Fp);
+  proto.Sp = F0.Sp == F1.Sp ? F0.Sp : Mat3(s0 * F0.Sp + s1 * F1.Sp);
+  proto.damage = F0.damage == F1.damage ? F0.damage : s0 * F0.damage + s1 * F1.damage;
 
   m.remove_face(f0);
   m.remove_face(f1);

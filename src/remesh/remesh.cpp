@@ -9,6 +9,7 @@
 #include "collision/distance.hpp"
 #include "mesh/edits.hpp"
 #include "mesh/validate.hpp"
+#include "plasticity/plastic_embedding.hpp"
 
 namespace arcsim {
 
@@ -275,6 +276,30 @@ class Remesher {
     if (reproject_node(m_, materials_, node, o_.reprojection).moved) ++stats_.reprojections;
   }
 
+  // --- plastic transfer (paper §5.2) ----------------------------------------------------------------------
+
+  // Before an edit of `faces`: true if they hold plastic state to transfer; with the embedding transfer, their
+  // plastic embedding is built into `embedding`.
+  bool capture_plastic(const std::vector<int>& faces, PlasticEmbedding& embedding) const {
+    std::vector<int> live;
+    for (int f : faces)
+      if (f != kNone) live.push_back(f);
+    if (!neighbourhood_has_plasticity(m_, materials_, live)) return false;
+    if (o_.sizing.remeshing.plastic_embedding) embedding = build_plastic_embedding(m_, live);
+    return true;
+  }
+
+  // After the edit (and the rest-angle update): Fp, Sp and edge rest angles of the new faces, from the
+  // embedding or, with "plastic_transfer": "interpolate", from the edit's interpolated Sp.
+  void transfer_plastic(const EditResult& r, bool plastic, const PlasticEmbedding& embedding) {
+    if (!plastic) return;
+    if (o_.sizing.remeshing.plastic_embedding) {
+      rebuild_plasticity_from_embedding(m_, materials_, embedding, r.added_faces);
+    } else {
+      interpolate_plasticity(m_, materials_, r.added_faces);
+    }
+  }
+
   // --- flips ------------------------------------------------------------------------------------------------
 
   // Flips on independent sets: within a pass no two flipped edges share a face (an edge whose face was
@@ -294,12 +319,15 @@ class Remesher {
           continue;
         }
         if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change)) continue;
+        PlasticEmbedding embedding;
+        const bool plastic = capture_plastic({f0, f1}, embedding);
         const EditResult r = flip_edge(m_, e);
         if (!r.ok) continue;
         ++done;
         ++stats_.flips;
         record(r);
         refresh_rest_angles(r.added_faces);
+        transfer_plastic(r, plastic, embedding);
         used.insert(r.added_faces.begin(), r.added_faces.end());
         for (int ne : edges_of_faces(m_, r.added_faces)) next.push_back(ne);
       }
@@ -359,7 +387,8 @@ class Remesher {
       for (int s = 0; s < 2; ++s) {
         const int f = m_.edges[e].f[s];
         if (f == kNone) continue;
-        l = std::max(l, (m_.verts[vert_at(m_, f, m_.edges[e].n[1])].u - m_.verts[vert_at(m_, f, m_.edges[e].n[0])].u).norm());
+        const Vec3& u0 = m_.verts[vert_at(m_, f, m_.edges[e].n[0])].u;
+        l = std::max(l, (m_.verts[vert_at(m_, f, m_.edges[e].n[1])].u - u0).norm());
       }
       return l;
     }();
@@ -369,6 +398,9 @@ class Remesher {
       const int f = m_.edges[e].f[s];
       if (f != kNone) active_by_corner.emplace_back(m_.opposite_node(e, f), is_active(f));
     }
+    const int end0 = m_.edges[e].n[0], end1 = m_.edges[e].n[1];
+    PlasticEmbedding embedding;
+    const bool plastic = capture_plastic({m_.edges[e].f[0], m_.edges[e].f[1]}, embedding);
     const EditResult r = split_edge(m_, e, 0.5);
     if (!r.ok) return false;
     ++stats_.splits;
@@ -391,6 +423,15 @@ class Remesher {
         m_.nodes[node].x0 += shift;
       }
     }
+    if (plastic && embedding.has(end0) && embedding.has(end1)) {
+      // Paper §5.2: the new node starts at the middle of the embedded edge and settles by Eq. 12.
+      embedding.set(node, 0.5 * (embedding.at(end0) + embedding.at(end1)));
+      place_node_in_embedding(m_, materials_, embedding, node);
+      const Vec3 shift = world_position_from_embedding(m_, embedding, node) - m_.nodes[node].x;
+      m_.nodes[node].x += shift;
+      m_.nodes[node].x0 += shift;
+    }
+    transfer_plastic(r, plastic, embedding);
     reproject(node);
     flip_around(node);
     return true;
@@ -405,7 +446,9 @@ class Remesher {
       }
       if (long_edges.empty()) return;
       std::sort(long_edges.begin(), long_edges.end(),
-                [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+                [](const auto& a, const auto& b) {
+                  return a.first > b.first || (a.first == b.first && a.second < b.second);
+                });
       int count = 0;
       for (const auto& [length, e] : long_edges) {
         if (live_faces_ >= static_cast<long>(o_.max_faces)) return;
@@ -420,8 +463,10 @@ class Remesher {
   // ARCSim's collapse rules (facts §5.3) on the faces that survive around the removed node, checked before the
   // edit: mean-ratio aspect at least aspect_min (or, for a face already below it, no worse than before), rest
   // area at least 0.1 size_min^2 (or no smaller than before), rest normal not reversed, world normal not
-  // reversed, every new edge's metric length <= 0.9. The removed node must be unpreserved, unlabelled and, on
-  // the boundary, on a straight piece of it (boundary_node_on_chord); topology (boundary, preserved edges, link condition, seams) is checked by collapse_edge itself.
+  // reversed, every new edge's metric length <= 0.9; and the world surface change limit (max_surface_change).
+  // The removed node must be unpreserved, unlabelled, inside the subset and, on the boundary, on a straight
+  // piece of it (boundary_node_on_chord). Topology (boundary, preserved edges, link condition, seams) is checked
+  // by collapse_edge itself.
   bool can_collapse(int e, int remove_side) const {
     const Edge& edge = m_.edges[e];
     const int gone = edge.n[remove_side], keep = edge.n[1 - remove_side];
@@ -456,7 +501,8 @@ class Remesher {
       for (int k = 1; k <= 2; ++k)
         if (vert_pair_metric_length(m_, it->second, nv[(c + k) % 3]) > kCollapseMetricLimit) return false;
       gone_to_surface = std::min(gone_to_surface, vertex_face_closest(g.x, x[0], x[1], x[2]).distance);
-      gone_to_rest_surface = std::min(gone_to_rest_surface, vertex_face_closest(m_.verts[face.v[c]].u, u0, u1, u2).distance);
+      gone_to_rest_surface =
+          std::min(gone_to_rest_surface, vertex_face_closest(m_.verts[face.v[c]].u, u0, u1, u2).distance);
     }
     // The removed node's distance to the faces that replace its fan bounds how far the surface moves; the part
     // the rest shape has too (a curved rest surface being coarsened) is no elastic change.
@@ -493,11 +539,14 @@ class Remesher {
     for (int side = 0; side < 2; ++side) {
       if (!can_collapse(e, side)) continue;
       const int keep = m_.edges[e].n[1 - side];
+      PlasticEmbedding embedding;
+      const bool plastic = capture_plastic(node_faces(m_, m_.edges[e].n[side]), embedding);
       const EditResult r = collapse_edge(m_, e, side);
       if (!r.ok) continue;
       ++stats_.collapses;
       record(r);
       refresh_rest_angles(r.added_faces);
+      transfer_plastic(r, plastic, embedding);
       reproject(keep);
       flip_around(keep);
       return true;

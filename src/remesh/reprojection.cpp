@@ -39,7 +39,8 @@ MembraneElement membrane_element(const Mesh& mesh, const std::vector<Material>& 
   const Material& m = materials[face.material];
   MembraneElement el;
   for (int i = 0; i < 3; ++i) el.nodes[i] = mesh.face_node(f, i);
-  const Mat2 Fp = face.Fp.isIdentity(0) ? Mat2::Identity() : Mat2(face.rest_frame.transpose() * face.Fp * face.rest_frame);
+  const Mat2 Fp =
+      face.Fp.isIdentity(0) ? Mat2::Identity() : Mat2(face.rest_frame.transpose() * face.Fp * face.rest_frame);
   el.Dm_inv = face.Dm_inv * Fp;
   el.area = face.rest_area;
   el.k = m.membrane_stiffness(face.thickness);

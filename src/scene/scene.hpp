@@ -21,6 +21,7 @@ struct RemeshingParams {
   double size_max = kInfinity;            // m
   double size_uniform = kInfinity;        // m, for soft-handle regions
   double aspect_min = -kInfinity;
+  bool plastic_embedding = true;  // "plastic_transfer": "embedding" (paper §5.2) or "interpolate" (false)
   bool has_size = false, has_aspect_min = false, has_refine_compression = false, has_refine_fracture = false;
 };
 

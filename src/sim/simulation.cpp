@@ -1,11 +1,13 @@
 #include "sim/simulation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "plasticity/plastic_step.hpp"
 #include "remesh/remesh_cloth.hpp"
 
 namespace arcsim {
@@ -287,11 +289,28 @@ void Simulation::advance_step() {
   times.collision += seconds_since(t0);
   check_state();
 
+  t0 = std::chrono::steady_clock::now();
+  plasticity_step(dt);
+  times.plasticity += seconds_since(t0);
+
   if (step_ % frame_steps_ == 0) {
     t0 = std::chrono::steady_clock::now();
     remeshing_step();
     times.remeshing += seconds_since(t0);
     ++frame_;
+  }
+}
+
+void Simulation::plasticity_step(double dt) {
+  plastic_work.resize(cloths.size(), 0.0);
+  if ((step_ - 1) % frame_steps_ == 0) std::fill(plastic_work.begin(), plastic_work.end(), 0.0);
+  if (!scene_.enabled("plasticity")) return;
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    Cloth& cloth = cloths[c];
+    if (!has_plasticity(cloth.materials)) continue;
+    const PlasticStepResult r = plastic_step(cloth.mesh, cloth.materials, dt);
+    plastic_work[c] += r.work();
+    if (r.changed()) cloth.elements_dirty = true;
   }
 }
 

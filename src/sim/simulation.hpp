@@ -85,6 +85,13 @@ class Simulation {
   std::vector<Obstacle> obstacles;
   std::vector<Handle> handles;
   ModuleTimes times;
+  // Impact-zone statistics summed over the steps since clear_collision_totals() (the command line clears them
+  // at each frame's start, so they describe one frame).
+  const ImpactZoneTotals& collision_totals() const { return collisions_.totals(); }
+  void clear_collision_totals() { collisions_.clear_totals(); }
+  // Per cloth, the plastic work (J, plasticity/plastic_step.hpp) of the steps of the current frame so far; reset
+  // at each frame's first step, so after advance_frame() it is the work of that frame.
+  std::vector<double> plastic_work;
   // Per cloth, the operation counts of the last frame-end remeshing pass (active_faces left empty). Mesh sizes
   // for the log: remesh/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
   std::vector<RemeshStats> remesh_stats;
@@ -112,6 +119,8 @@ class Simulation {
   std::vector<std::vector<ContactTerm>> proximity_step(double dt);
   void physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts);
   void collision_step(double dt);
+  // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
+  void plasticity_step(double dt);
   // Frame-end remeshing of every cloth (module "remeshing", unless the mesh is fixed), then compaction.
   void remeshing_step();
   void check_state() const;

@@ -59,6 +59,43 @@ TEST(FrameLog, LineParsesWithEveryFieldInOrder) {
   EXPECT_EQ(v.size(), 7u);
 }
 
+TEST(FrameLog, ImpactZoneStatisticsWhenCollisionsRan) {
+  FrameReport r;
+  r.has_impact_zones = true;
+  r.impact_zones.steps = 8;
+  r.impact_zones.impacts = 41;
+  r.impact_zones.zones = 5;
+  r.impact_zones.iterations = 19;
+  r.impact_zones.largest_zone = 12;
+  r.impact_zones.fallback_zones = 1;
+  r.impact_zones.unresolved_steps = 0;
+  const Json::Value z = parse(frame_log_line(r))["impact_zones"];
+  ASSERT_TRUE(z.isObject());
+  EXPECT_EQ(z["steps"].asInt(), 8);
+  EXPECT_EQ(z["impacts"].asInt(), 41);
+  EXPECT_EQ(z["zones"].asInt(), 5);
+  EXPECT_EQ(z["iterations"].asInt(), 19);
+  EXPECT_EQ(z["largest_zone"].asInt(), 12);
+  EXPECT_EQ(z["fallback_zones"].asInt(), 1);
+  EXPECT_EQ(z["unresolved_steps"].asInt(), 0);
+  r.has_impact_zones = false;
+  EXPECT_FALSE(parse(frame_log_line(r)).isMember("impact_zones"));
+}
+
+TEST(FrameLog, MeshSizesPerCloth) {
+  FrameReport r;
+  r.meshes.push_back({200, 0.01, 0.02, 0.05});
+  r.meshes.push_back({8, 0.5, 0.75, 1.0});
+  const Json::Value m = parse(frame_log_line(r))["meshes"];
+  ASSERT_TRUE(m.isObject());
+  EXPECT_EQ(m["cloth0"]["faces"].asInt(), 200);
+  EXPECT_EQ(m["cloth0"]["edge_min"].asDouble(), 0.01);
+  EXPECT_EQ(m["cloth0"]["edge_median"].asDouble(), 0.02);
+  EXPECT_EQ(m["cloth0"]["edge_max"].asDouble(), 0.05);
+  EXPECT_EQ(m["cloth1"]["faces"].asInt(), 8);
+  EXPECT_EQ(m["cloth1"]["edge_max"].asDouble(), 1.0);
+}
+
 TEST(FrameLog, ProgressLineHasNullTotalWhenUnbounded) {
   FrameReport r;
   r.frame = 3;
