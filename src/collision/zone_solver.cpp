@@ -87,12 +87,18 @@ double augmented_lagrangian(unsigned n, const double* y, double* grad, void* dat
 
 // Outer loop: minimise L with NLopt's L-BFGS, update the multipliers, raise the penalty while the
 // violation does not shrink fast enough. Tolerances are in units of the thickness.
+// The penalty is capped at a moderate value: the multiplier updates converge for any fixed penalty, whereas
+// a penalty driven to 1e8 makes L-BFGS stall within its evaluation budget on large contact zones
+// (measured on sphere.json: 170-440 node zones left 0.3 thickness inside, then cascaded into thousands of
+// impacts per round). More, cheaper outer rounds replace the large penalties.
+constexpr double kMaxPenalty = 1e4;
+constexpr int kMaxOuterIterations = 200;
 void sparse_augmented_lagrangian(ScaledZone& zone, std::vector<double>& y) {
   const unsigned n = static_cast<unsigned>(y.size());
   const size_t m = zone.b.size();
   AugmentedLagrangian al{&zone, std::vector<double>(m, 0.0), 10.0};
   double previous_violation = kInfinity;
-  for (int outer = 0; outer < 40; ++outer) {
+  for (int outer = 0; outer < kMaxOuterIterations; ++outer) {
     nlopt::opt inner(nlopt::LD_LBFGS, n);
     inner.set_min_objective(augmented_lagrangian, &al);
     // Loose inner tolerances: the multiplier updates correct what an inexact inner solve leaves (tightening
@@ -115,7 +121,7 @@ void sparse_augmented_lagrangian(ScaledZone& zone, std::vector<double>& y) {
       slack = std::max(slack, al.lambda[k] * std::abs(c));
     }
     if (violation <= 1e-3 && slack <= 1e-4) break;
-    if (violation > 0.25 * previous_violation) al.mu = std::min(al.mu * 10, 1e8);
+    if (violation > 0.25 * previous_violation) al.mu = std::min(al.mu * 10, kMaxPenalty);
     previous_violation = violation;
   }
 }
