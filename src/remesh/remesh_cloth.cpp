@@ -13,6 +13,7 @@ RemeshOptions remesh_options(const Scene& scene) {
   o.sizing.combine_tensors = scene.magic.combine_tensors;
   o.edge_flip_threshold = scene.magic.edge_flip_threshold;
   o.reprojection.gravity = scene.gravity;
+  o.reprojection.max_displacement = 0.5 * scene.magic.repulsion_thickness;
   return o;
 }
 

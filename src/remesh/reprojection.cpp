@@ -190,6 +190,18 @@ ReprojectionResult reproject_node(Mesh& mesh, const std::vector<Material>& mater
   const double length = local_length(mesh, node);
   if (!(length > 0)) return result;
   const Vec3 start = mesh.nodes[node].x;
+  // Trial points keep their motion across the sheet (along the mean world normal of the node's faces) within
+  // max_displacement; motion within the sheet cannot carry it through a nearby layer and stays free (it is
+  // what removes the in-plane stress a split or collapse leaves).
+  Vec3 normal = Vec3::Zero();
+  for (int f : node_faces(mesh, node)) normal += mesh.world_normal(f);
+  if (normal.norm() > 0) normal.normalize();
+  auto within_reach = [&](const Vec3& p) -> Vec3 {
+    const Vec3 d = p - start;
+    const double across = d.dot(normal);
+    if (std::abs(across) <= params.max_displacement) return p;
+    return p - (across - std::copysign(params.max_displacement, across)) * normal;
+  };
   Vec3 x = start;
   LocalEnergy current = evaluate(mesh, els, node, x, load, start, true);
   result.energy_before = result.energy_after = current.energy;
@@ -215,16 +227,17 @@ ReprojectionResult reproject_node(Mesh& mesh, const std::vector<Material>& mater
     double alpha = 1;
     LocalEnergy trial;
     for (int ls = 0; ls < 16; ++ls, alpha *= 0.5) {
-      trial = evaluate(mesh, els, node, x + alpha * step, load, start, false);
+      trial = evaluate(mesh, els, node, within_reach(x + alpha * step), load, start, false);
       if (std::isfinite(trial.energy) && trial.energy < current.energy) {
         accepted = true;
         break;
       }
     }
     if (!accepted) break;
-    x += alpha * step;
+    const Vec3 moved_by = within_reach(x + alpha * step) - x;
+    x += moved_by;
     current = evaluate(mesh, els, node, x, load, start, true);
-    if ((alpha * step).norm() < 1e-13 * length) break;
+    if (moved_by.norm() < 1e-13 * length) break;
   }
   result.energy_after = current.energy;
   if (x != start) {

@@ -48,6 +48,34 @@ TEST(Reprojection, OutOfPlaneDisplacementShrinks) {
   EXPECT_LT(std::abs(m.nodes[n].x.z()), 0.1 * 0.02);
 }
 
+TEST(Reprojection, MotionAcrossTheSheetIsLimitedInPlaneMotionIsNot) {
+  // The node is 20 mm above a flat sheet and 30 mm off in the plane. With a 2 mm limit across the sheet it
+  // moves exactly 2 mm across (never further, which could cross a nearby layer), while its in-plane offset
+  // still relaxes; the energy still decreases.
+  Mesh m = testing::make_grid(6, 6, 0.6, 0.6);
+  const std::vector<Material> materials{cotton()};
+  set_thickness(m, materials[0]);
+  const int n = middle_node(m, Vec3(0.3, 0.3, 0));
+  const Vec3 rest = m.nodes[n].x;
+  m.nodes[n].x += Vec3(0.03, 0, 0.02);
+  ReprojectionParams params;
+  params.max_displacement = 0.002;
+  const Vec3 start = m.nodes[n].x;
+  // "Across" is the mean world normal of the node's faces at the start.
+  Vec3 normal = Vec3::Zero();
+  for (size_t f = 0; f < m.faces.size(); ++f)
+    for (int i = 0; i < 3; ++i)
+      if (m.face_node(static_cast<int>(f), i) == n) normal += m.world_normal(static_cast<int>(f));
+  normal.normalize();
+  const ReprojectionResult r = reproject_node(m, materials, n, params);
+  EXPECT_TRUE(r.moved);
+  EXPECT_LT(r.energy_after, r.energy_before);
+  const Vec3 moved = m.nodes[n].x - start;
+  EXPECT_LE(std::abs(moved.dot(normal)), 0.002 * (1 + 1e-9));
+  EXPECT_GT(std::abs(moved.dot(normal)), 0.0019);  // the limit is what stopped it
+  EXPECT_LT(std::abs(m.nodes[n].x.x() - rest.x()), 0.5 * 0.03);
+}
+
 TEST(Reprojection, AccelerationTermBalancesElasticForce) {
   // A pre-stretched sheet (so it has out-of-plane stiffness); the node had acceleration a = -5 m/s^2 along z.
   // At the minimiser the elastic force equals m a: the node sits above the plane, pulled down by its
