@@ -1,6 +1,7 @@
 #include "plasticity/plastic_tensors.hpp"
 
 #include <array>
+#include <unordered_map>
 
 #include <Eigen/LU>
 
@@ -74,37 +75,48 @@ Vec3 face_offsets_from_bending_strain(const Mesh& mesh, int face, const Mat3& S)
   return d.allFinite() ? d : Vec3::Zero();
 }
 
+namespace {
+
+// Mean of value(face, side) over the live faces of edge e (0 for an edge without any).
+template <typename Value>
+double mean_over_edge_faces(const Mesh& mesh, int e, Value value) {
+  const Edge& ed = mesh.edges[e];
+  double sum = 0;
+  int count = 0;
+  for (int side = 0; side < 2; ++side) {
+    if (!live_face(mesh, ed.f[side])) continue;
+    ++count;
+    sum += value(ed.f[side]);
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+}  // namespace
+
 void update_edge_rest_angles_from_Sp(Mesh& mesh, const std::vector<int>& edges) {
+  // Each face's offsets solve a 3x3 system; a face is reached from up to three of the edges, so solve it once.
+  std::unordered_map<int, Vec3> offsets;
+  auto face_offsets = [&](int f) -> const Vec3& {
+    auto it = offsets.find(f);
+    if (it == offsets.end())
+      it = offsets.emplace(f, face_offsets_from_bending_strain(mesh, f, mesh.faces[f].Sp)).first;
+    return it->second;
+  };
   for (int e : edges_or_all(mesh, edges)) {
-    Edge& ed = mesh.edges[e];
-    if (ed.dead) continue;
-    double sum = 0;
-    int count = 0;
-    for (int side = 0; side < 2; ++side) {
-      const int f = ed.f[side];
-      if (!live_face(mesh, f)) continue;
-      ++count;
+    if (mesh.edges[e].dead) continue;
+    const double offset = mean_over_edge_faces(mesh, e, [&](int f) {
       const Face& face = mesh.faces[f];
       const int slot = edge_slot(face, e);
-      if (slot == kNone || face.Sp.isZero(0)) continue;
-      sum += face_offsets_from_bending_strain(mesh, f, face.Sp)[slot];
-    }
-    ed.rest_theta = mesh.rest_dihedral(e) + (count > 0 ? sum / count : 0.0);
+      return (slot == kNone || face.Sp.isZero(0)) ? 0.0 : face_offsets(f)[slot];
+    });
+    mesh.edges[e].rest_theta = mesh.rest_dihedral(e) + offset;
   }
 }
 
 void update_edge_damage_from_faces(Mesh& mesh, const std::vector<int>& edges) {
   for (int e : edges_or_all(mesh, edges)) {
-    Edge& ed = mesh.edges[e];
-    if (ed.dead) continue;
-    double sum = 0;
-    int count = 0;
-    for (int side = 0; side < 2; ++side) {
-      if (!live_face(mesh, ed.f[side])) continue;
-      sum += mesh.faces[ed.f[side]].damage;
-      ++count;
-    }
-    ed.damage = count > 0 ? sum / count : 0.0;
+    if (mesh.edges[e].dead) continue;
+    mesh.edges[e].damage = mean_over_edge_faces(mesh, e, [&](int f) { return mesh.faces[f].damage; });
   }
 }
 
