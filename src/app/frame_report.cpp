@@ -41,6 +41,9 @@ std::string frame_log_line(const FrameReport& r) {
           .number("edge_min", m.edge_min)
           .number("edge_median", m.edge_median)
           .number("edge_max", m.edge_max);
+      if (m.remeshed)
+        mesh.integer("splits", m.splits).integer("flips", m.flips).integer("collapses", m.collapses)
+            .integer("guarded", m.guarded);
       meshes.object(("cloth" + std::to_string(c)).c_str(), mesh);
     }
     line.object("meshes", meshes);

@@ -18,6 +18,9 @@ struct FrameWallTimes {
 struct ClothMeshReport {
   long long faces = 0;
   double edge_min = 0, edge_median = 0, edge_max = 0;  // world edge lengths (m)
+  bool remeshed = false;  // the frame ended with a remeshing pass: the counts below are its edits
+  int splits = 0, flips = 0, collapses = 0;
+  int guarded = 0;        // edits and moves the world-space guard refused (remesh/world_guard.hpp)
 };
 
 struct FrameReport {
@@ -36,7 +39,8 @@ struct FrameReport {
 
 // {"frame":..,"time":..,"steps":..,"nodes":..,"faces":..,"saved":..,"wall":{"physics":..,...,"total":..}}, then
 // "plastic_work":{"total":..,"cloth0":..,...} (J) when plastic_work is not empty, then
-// "meshes":{"cloth0":{"faces":..,"edge_min":..,"edge_median":..,"edge_max":..},...} (m) when meshes is not empty,
+// "meshes":{"cloth0":{"faces":..,"edge_min":..,"edge_median":..,"edge_max":..[,"splits":..,"flips":..,
+// "collapses":..,"guarded":..]},...} (m) when meshes is not empty (the edit counts when remeshed),
 // then "impact_zones":{"steps":..,"impacts":..,"zones":..,"iterations":..,"largest_zone":..,"fallback_zones":..,
 // "unresolved_steps":..} when has_impact_zones.
 std::string frame_log_line(const FrameReport& report);

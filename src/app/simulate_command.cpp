@@ -49,11 +49,20 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 void count_elements(const Simulation& sim, FrameReport& report) {
   report.nodes = report.faces = 0;
   report.meshes.clear();
-  for (const Cloth& c : sim.cloths) {
+  for (size_t i = 0; i < sim.cloths.size(); ++i) {
+    const Cloth& c = sim.cloths[i];
     report.nodes += static_cast<long long>(c.mesh.nodes.size());
     report.faces += static_cast<long long>(c.mesh.faces.size());
     const MeshSizeStats s = mesh_size_stats(c.mesh);
-    report.meshes.push_back({s.faces, s.edge_min, s.edge_median, s.edge_max});
+    ClothMeshReport m;
+    m.faces = s.faces;
+    m.edge_min = s.edge_min, m.edge_median = s.edge_median, m.edge_max = s.edge_max;
+    if (i < sim.remesh_stats.size()) {
+      const RemeshStats& r = sim.remesh_stats[i];
+      m.remeshed = true;
+      m.splits = r.splits, m.flips = r.flips, m.collapses = r.collapses, m.guarded = r.guarded;
+    }
+    report.meshes.push_back(m);
   }
 }
 

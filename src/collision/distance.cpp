@@ -141,4 +141,41 @@ ClosestPoints vertex_edge_closest(const Vec3& p, const Vec3& a, const Vec3& b) {
   return from_gap(gap, any_perpendicular(b - a), scale, {1, -(1 - s), -s, 0});
 }
 
+namespace {
+
+// True if segment (p, q) passes through the interior of triangle t (crossing its plane, not lying in it).
+bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const std::array<Vec3, 3>& t) {
+  const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+  const double dp = n.dot(p - t[0]), dq = n.dot(q - t[0]);
+  if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || dp == dq) return false;
+  const Vec3 r = p + dp / (dp - dq) * (q - p);
+  for (int i = 0; i < 3; ++i) {
+    const Vec3& a = t[i];
+    const Vec3& b = t[(i + 1) % 3];
+    if (n.dot((b - a).cross(r - a)) < 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool triangles_cross(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b) {
+  for (int i = 0; i < 3; ++i)
+    if (segment_crosses_triangle(a[i], a[(i + 1) % 3], b) || segment_crosses_triangle(b[i], b[(i + 1) % 3], a))
+      return true;
+  return false;
+}
+
+double triangle_separation(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b) {
+  if (triangles_cross(a, b)) return 0;
+  double d = kInfinity;
+  for (int i = 0; i < 3; ++i) {
+    d = std::min(d, vertex_face_closest(a[i], b[0], b[1], b[2]).distance);
+    d = std::min(d, vertex_face_closest(b[i], a[0], a[1], a[2]).distance);
+    for (int j = 0; j < 3; ++j)
+      d = std::min(d, edge_edge_closest(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]).distance);
+  }
+  return d;
+}
+
 }  // namespace arcsim

@@ -39,6 +39,15 @@ Vec3 closest_triangle_barycentrics(const Vec3& p, const Vec3& a, const Vec3& b, 
 // Parameters (s, u) of the closest points of segments p0 + s (p1 - p0) and q0 + u (q1 - q0), in [0, 1].
 Vec2 closest_segment_parameters(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
 
+// True if an edge of either triangle passes through the other (crossing its plane inside it). Coplanar
+// overlaps do not count: they show as zero distances between edges or vertices and faces.
+bool triangles_cross(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b);
+
+// Smallest distance between triangles (a0, a1, a2) and (b0, b1, b2) (m): 0 when an edge of one crosses the
+// other, else the least of the 6 vertex-face and 9 edge-edge distances. Floating point: a crossing within
+// rounding of a triangle's border shows as a near-zero edge-edge distance instead.
+double triangle_separation(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b);
+
 // Any unit vector perpendicular to d (d nonzero); UnitZ for d = 0.
 Vec3 any_perpendicular(const Vec3& d);
 

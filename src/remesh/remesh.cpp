@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <unordered_set>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include "mesh/edits.hpp"
 #include "mesh/validate.hpp"
 #include "plasticity/plastic_embedding.hpp"
+#include "remesh/world_guard.hpp"
 
 namespace arcsim {
 
@@ -162,6 +164,7 @@ class Remesher {
     const RemeshingParams& r = o_.sizing.remeshing;
     aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
     min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
+    if (o_.world_clearance > 0) guard_ = std::make_unique<WorldGuard>(m_, o_.obstacles, o_.world_clearance);
   }
 
   RemeshStats run() {
@@ -273,7 +276,77 @@ class Remesher {
 
   void reproject(int node) {
     if (!o_.reproject || m_.nodes[node].preserve) return;
-    if (reproject_node(m_, materials_, node, o_.reprojection).moved) ++stats_.reprojections;
+    const Vec3 x = m_.nodes[node].x, x0 = m_.nodes[node].x0;
+    std::vector<GuardTriangle> before;
+    if (guard_) before = guard_->fan(node);
+    if (!reproject_node(m_, materials_, node, o_.reprojection).moved) return;
+    if (!keep_move(node, before, x, x0)) return;
+    ++stats_.reprojections;
+  }
+
+  // --- world-space guard --------------------------------------------------------------------------------------
+
+  // After `node` moved from (x, x0), where its faces were `before`: keeps the move if the guard allows it
+  // (and indexes the moved faces), else puts the node back. True if the move stays.
+  bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0) {
+    if (!guard_) return true;
+    if (m_.nodes[node].x != x && !guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), {})) {
+      m_.nodes[node].x = x;
+      m_.nodes[node].x0 = x0;
+      ++stats_.guarded;
+      return false;
+    }
+    guard_->update_node(node);
+    return true;
+  }
+
+  void index_faces(const std::vector<int>& faces) {
+    if (!guard_) return;
+    for (int f : faces) guard_->update_face(f);
+  }
+
+  GuardTriangle world_triangle(std::array<int, 3> nodes) const {
+    GuardTriangle t;
+    t.nodes = nodes;
+    for (int i = 0; i < 3; ++i) t.x[i] = m_.nodes[nodes[i]].x;
+    return t;
+  }
+
+  GuardTriangle face_triangle(int f) const {
+    return world_triangle({m_.face_node(f, 0), m_.face_node(f, 1), m_.face_node(f, 2)});
+  }
+
+  // Whether flipping interior edge e keeps the world surface clear.
+  bool guard_allows_flip(int e) const {
+    if (!guard_) return true;
+    const Edge& edge = m_.edges[e];
+    const int a = m_.opposite_node(e, edge.f[0]), b = m_.opposite_node(e, edge.f[1]);
+    const std::vector<GuardTriangle> before{face_triangle(edge.f[0]), face_triangle(edge.f[1])};
+    const std::vector<GuardTriangle> after{world_triangle({edge.n[0], a, b}), world_triangle({edge.n[1], b, a})};
+    const std::array<int, 4> quad{edge.n[0], edge.n[1], a, b};
+    GuardSweep sweep{{}, quad};
+    for (int i = 0; i < 4; ++i) sweep.x[i] = m_.nodes[quad[i]].x;
+    return guard_->allows(before, after, {sweep}, {edge.f[0], edge.f[1]});
+  }
+
+  // Whether collapsing edge e by removing node `gone` into node `keep` keeps the world surface clear.
+  bool guard_allows_collapse(int e, int gone, int keep) const {
+    if (!guard_) return true;
+    // The removed node slides to the kept one: each surviving face of its fan sweeps a tetrahedron.
+    const std::vector<int> fan = node_faces(m_, gone);
+    std::vector<GuardTriangle> before, after;
+    std::vector<GuardSweep> sweeps;
+    for (int f : fan) {
+      before.push_back(face_triangle(f));
+      if (f == m_.edges[e].f[0] || f == m_.edges[e].f[1]) continue;
+      const int c = m_.corner_of_node(f, gone);
+      const int b0 = m_.face_node(f, (c + 1) % 3), b1 = m_.face_node(f, (c + 2) % 3);
+      std::array<int, 3> nodes{m_.face_node(f, 0), m_.face_node(f, 1), m_.face_node(f, 2)};
+      nodes[c] = keep;
+      after.push_back(world_triangle(nodes));
+      sweeps.push_back({{m_.nodes[gone].x, m_.nodes[keep].x, m_.nodes[b0].x, m_.nodes[b1].x}, {gone, keep, b0, b1}});
+    }
+    return guard_->allows(before, after, sweeps, fan);
   }
 
   // --- plastic transfer (paper §5.2) ----------------------------------------------------------------------
@@ -319,6 +392,10 @@ class Remesher {
           continue;
         }
         if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change)) continue;
+        if (!guard_allows_flip(e)) {
+          ++stats_.guarded;
+          continue;
+        }
         PlasticEmbedding embedding;
         const bool plastic = capture_plastic({f0, f1}, embedding);
         const EditResult r = flip_edge(m_, e);
@@ -326,6 +403,7 @@ class Remesher {
         ++done;
         ++stats_.flips;
         record(r);
+        index_faces(r.added_faces);
         refresh_rest_angles(r.added_faces);
         transfer_plastic(r, plastic, embedding);
         used.insert(r.added_faces.begin(), r.added_faces.end());
@@ -405,7 +483,13 @@ class Remesher {
     if (!r.ok) return false;
     ++stats_.splits;
     record(r, &active_by_corner);
+    index_faces(r.added_faces);
     const int node = r.added_nodes[0];
+    // The midpoint lies on the old surface; the moves below (onto the curved rest shape, into the plastic
+    // embedding) are checked by the guard together.
+    const Vec3 mid_x = m_.nodes[node].x, mid_x0 = m_.nodes[node].x0;
+    std::vector<GuardTriangle> flat;
+    if (guard_) flat = guard_->fan(node);
 
     // Initial world guess follows the rest displacement through the old faces' deformation.
     Mat3 map = Mat3::Zero();
@@ -431,6 +515,7 @@ class Remesher {
       m_.nodes[node].x += shift;
       m_.nodes[node].x0 += shift;
     }
+    keep_move(node, flat, mid_x, mid_x0);
     transfer_plastic(r, plastic, embedding);
     reproject(node);
     flip_around(node);
@@ -539,12 +624,17 @@ class Remesher {
     for (int side = 0; side < 2; ++side) {
       if (!can_collapse(e, side)) continue;
       const int keep = m_.edges[e].n[1 - side];
+      if (!guard_allows_collapse(e, m_.edges[e].n[side], keep)) {
+        ++stats_.guarded;
+        continue;
+      }
       PlasticEmbedding embedding;
       const bool plastic = capture_plastic(node_faces(m_, m_.edges[e].n[side]), embedding);
       const EditResult r = collapse_edge(m_, e, side);
       if (!r.ok) continue;
       ++stats_.collapses;
       record(r);
+      index_faces(r.added_faces);
       refresh_rest_angles(r.added_faces);
       transfer_plastic(r, plastic, embedding);
       reproject(keep);
@@ -577,6 +667,7 @@ class Remesher {
   long live_faces_ = 0;
   bool curved_reference_ = false;
   double aspect_min_ = 0, min_area_ = 0;
+  std::unique_ptr<WorldGuard> guard_;
   RemeshStats stats_;
 };
 

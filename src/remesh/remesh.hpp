@@ -10,7 +10,8 @@
 // Every rest position a split creates is projected onto the cloth's reference surface along the averaged rest
 // normal, and edges whose faces change get rest angle = plastic offset + the reference's rest dihedral, so a
 // curved rest shape stays curved. After every split and collapse the changed node's world position is
-// reprojected (remesh/reprojection.hpp, paper Eq. 13). Loops are bounded (rounds, flips per call, face count).
+// reprojected (remesh/reprojection.hpp, paper Eq. 13). With a world clearance, no edit or move may bring the
+// surface into another one (remesh/world_guard.hpp). Loops are bounded (rounds, flips per call, face count).
 // The mesh is left with tombstones: the caller compacts.
 #pragma once
 
@@ -36,12 +37,17 @@ struct RemeshOptions {
   // quad's diagonals (world minus rest). WHY: the sizing lets an edge bend by up to refine_angle, and flattening
   // such a wrinkle in one remesh is a visible pop (ARCSim's square-pop scene). <= 0: no limit.
   double max_surface_change = 0.005;
+  // World-space guard (remesh/world_guard.hpp): an edit's new triangles keep this clearance (m) from every
+  // surface they do not touch (the mesh itself and `obstacles`), or come no closer than before. <= 0: off.
+  double world_clearance = 0;
+  std::vector<const Mesh*> obstacles;  // other surfaces the edits may not approach: obstacles, other cloths
   int max_rounds = 30;                 // split rounds and collapse rounds, each
   size_t max_faces = 2000000;          // no split beyond this many live faces (a safety net, not a size control)
 };
 
 struct RemeshStats {
   int splits = 0, flips = 0, collapses = 0, reprojections = 0;
+  int guarded = 0;  // edits and node moves refused (or undone) by the world-space guard
   // Live faces of the active region after the pass: the subset's surviving faces plus every face created
   // (all live faces when no subset was given). Indices before compaction.
   std::vector<int> active_faces;

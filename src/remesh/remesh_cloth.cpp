@@ -14,6 +14,9 @@ RemeshOptions remesh_options(const Scene& scene) {
   o.edge_flip_threshold = scene.magic.edge_flip_threshold;
   o.reprojection.gravity = scene.gravity;
   o.reprojection.max_displacement = 0.5 * scene.magic.repulsion_thickness;
+  // Edits keep the gap the impact-zone projection enforces (collision_settings in sim/simulation.cpp).
+  o.world_clearance = scene.magic.projection_thickness >= 0 ? scene.magic.projection_thickness
+                                                            : 0.1 * scene.magic.repulsion_thickness;
   return o;
 }
 

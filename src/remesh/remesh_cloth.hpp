@@ -12,7 +12,7 @@
 namespace arcsim {
 
 // Options from the scene: magic rib_stiffening, combine_tensors and edge_flip_threshold, gravity for the
-// reprojection. The per-cloth fields (remeshing parameters, reference) are filled in by remesh().
+// reprojection, the projection thickness as the world-space guard's clearance (the caller lists the obstacles). The per-cloth fields (remeshing parameters, reference) are filled in by remesh().
 // The obstacle-proximity sizing term stays off: the collision module provides no nearest obstacle planes yet.
 RemeshOptions remesh_options(const Scene& scene);
 

@@ -316,9 +316,13 @@ void Simulation::plasticity_step(double dt) {
 
 void Simulation::remeshing_step() {
   if (!scene_.enabled("remeshing") || scene_.magic.fixed_high_res_mesh) return;
-  const RemeshOptions options = remesh_options(scene_);
+  RemeshOptions options = remesh_options(scene_);
   remesh_stats.assign(cloths.size(), RemeshStats());
   for (size_t c = 0; c < cloths.size(); ++c) {
+    // The edits may not push this cloth into an obstacle or another cloth.
+    options.obstacles = active_obstacle_meshes(obstacles);
+    for (size_t other = 0; other < cloths.size(); ++other)
+      if (other != c) options.obstacles.push_back(&cloths[other].mesh);
     remesh_stats[c] = remesh(cloths[c], nullptr, options);
     remesh_stats[c].active_faces.clear();
     compact_cloth(static_cast<int>(c));

@@ -14,34 +14,11 @@
 #include "collision/tri_tri.hpp"
 #include "io/obj.hpp"
 #include "sim/simulation.hpp"
+#include "support/files.hpp"
 
 namespace arcsim::testing {
 
 namespace fs = std::filesystem;
-
-// The repository's meshes/ folder (tests run from the repository root; also found next to bin/ or this file).
-inline fs::path project_meshes() {
-  std::error_code no_throw;
-  const fs::path binary = fs::read_symlink("/proc/self/exe", no_throw);
-  for (const fs::path& candidate : {fs::path("meshes"), binary.parent_path().parent_path() / "meshes",
-                                    fs::path(__FILE__).parent_path() / "../../meshes"})
-    if (fs::exists(candidate / "square.obj", no_throw)) return candidate;
-  return {};
-}
-
-// A folder for generated meshes, removed with the object.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::random_device rd;
-    path = fs::temp_directory_path() / ("arcsim-collision-" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ignore;
-    fs::remove_all(path, ignore);
-  }
-};
 
 // A light, soft sheet (cloth-like): 0.15 kg/m^2.
 inline Material sheet_material() {

@@ -11,22 +11,13 @@
 
 #include "io/obj.hpp"
 #include "mesh/validate.hpp"
+#include "support/files.hpp"
 
 namespace arcsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The repository's meshes/ folder: from the working directory (the Makefile runs tests from the root), next
-// to the bin/ folder holding the test binary, or relative to this source file.
-fs::path project_meshes() {
-  std::error_code no_throw;
-  const fs::path binary = fs::read_symlink("/proc/self/exe", no_throw);
-  for (const fs::path& candidate : {fs::path("meshes"), binary.parent_path().parent_path() / "meshes",
-                                    fs::path(__FILE__).parent_path() / "../../meshes"})
-    if (fs::exists(candidate / "square.obj", no_throw)) return candidate;
-  return {};
-}
+using testing::project_meshes;
 
 fs::path arcsim_meshes() {
   const char* shared = std::getenv("ARCSIM_SHARED");

@@ -15,23 +15,13 @@
 #include "io/scene_parser.hpp"
 #include "io/state.hpp"
 #include "sim/simulation.hpp"
+#include "support/files.hpp"
 
 namespace arcsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "arcsim-state-XXXXXX").string();
-    if (::mkdtemp(pattern.data())) path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
-};
+using testing::TempDir;
 
 // Two triangles: the smallest sheet, so that a state file is small enough to try every prefix and byte.
 constexpr const char* kTinyObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";

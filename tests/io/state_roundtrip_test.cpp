@@ -18,34 +18,14 @@
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
 #include "support/mesh_factory.hpp"
+#include "support/files.hpp"
 
 namespace arcsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The repository's meshes/ folder: from the working directory (the Makefile runs tests from the root), beside
-// the bin/ folder of the test binary, or relative to this source file.
-fs::path project_meshes() {
-  std::error_code ignored;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ignored);
-  for (const fs::path& dir : {fs::path("meshes"), exe.parent_path().parent_path() / "meshes",
-                              fs::path(__FILE__).parent_path() / "../../meshes"})
-    if (fs::exists(dir / "square.obj", ignored)) return fs::absolute(dir);
-  return {};
-}
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "arcsim-state-XXXXXX").string();
-    if (::mkdtemp(pattern.data())) path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
-};
+using testing::project_meshes;
+using testing::TempDir;
 
 // Two materials, a static obstacle and two handles, so that every section has content.
 std::string two_material_scene(const fs::path& meshes) {

@@ -1,0 +1,229 @@
+#include "remesh/world_guard.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "collision/distance.hpp"
+
+namespace arcsim {
+
+namespace {
+
+// A face whose box spans more cells than this is checked against every query instead (large obstacle
+// triangles such as a floor).
+constexpr long kMaxCellsPerFace = 512;
+
+// Cell coordinates are offset into 21 bits each.
+constexpr int kCoordinateBits = 21;
+constexpr int kCoordinateOffset = 1 << (kCoordinateBits - 1);
+
+Eigen::AlignedBox3d box_of(const std::array<Vec3, 3>& x, double margin) {
+  Eigen::AlignedBox3d b;
+  for (const Vec3& p : x) b.extend(p);
+  b.min().array() -= margin;
+  b.max().array() += margin;
+  return b;
+}
+
+double median_edge_length(const Mesh& m) {
+  std::vector<double> lengths;
+  for (const Edge& e : m.edges)
+    if (!e.dead) lengths.push_back((m.nodes[e.n[1]].x - m.nodes[e.n[0]].x).norm());
+  if (lengths.empty()) return 0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+// Signed volume (times 6) of tetrahedron (a, b, c, d).
+double volume6(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return (b - a).dot((c - a).cross(d - a)); }
+
+// True if the triangle meets the solid tetrahedron: an edge of one crosses a face of the other, or the triangle
+// lies inside (its corners are).
+bool triangle_meets_tetrahedron(const std::array<Vec3, 3>& t, const std::array<Vec3, 4>& q) {
+  static constexpr int kFaces[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+  for (const auto& f : kFaces)
+    if (triangles_cross(t, {q[f[0]], q[f[1]], q[f[2]]})) return true;
+  const double v = volume6(q[0], q[1], q[2], q[3]);
+  if (v == 0) return false;
+  for (const Vec3& p : t) {
+    const double s0 = volume6(p, q[1], q[2], q[3]), s1 = volume6(q[0], p, q[2], q[3]);
+    const double s2 = volume6(q[0], q[1], p, q[3]), s3 = volume6(q[0], q[1], q[2], p);
+    if (s0 * v >= 0 && s1 * v >= 0 && s2 * v >= 0 && s3 * v >= 0) return true;
+  }
+  return false;
+}
+
+// A ball holding the points (centre: their mean): the distance between two point sets is at least the
+// distance between their balls, a cheap test before the exact ones.
+template <size_t N>
+std::pair<Vec3, double> enclosing_ball(const std::array<Vec3, N>& x) {
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& p : x) centre += p / static_cast<double>(N);
+  double radius = 0;
+  for (const Vec3& p : x) radius = std::max(radius, (p - centre).norm());
+  return {centre, radius};
+}
+
+template <size_t N, size_t M>
+double ball_gap(const std::array<Vec3, N>& a, const std::array<Vec3, M>& b) {
+  const auto [ca, ra] = enclosing_ball(a);
+  const auto [cb, rb] = enclosing_ball(b);
+  return (ca - cb).norm() - ra - rb;
+}
+
+}  // namespace
+
+WorldGuard::WorldGuard(const Mesh& mesh, const std::vector<const Mesh*>& others, double clearance)
+    : mesh_(mesh), clearance_(clearance) {
+  meshes_.push_back(&mesh);
+  meshes_.insert(meshes_.end(), others.begin(), others.end());
+  // Cells about an edge long: a query touches a few cells and each holds a few faces.
+  cell_ = std::max({median_edge_length(mesh), 4 * clearance, 1e-6});
+  for (size_t k = 0; k < meshes_.size(); ++k)
+    for (size_t f = 0; f < meshes_[k]->faces.size(); ++f)
+      if (!meshes_[k]->faces[f].dead) insert(static_cast<int>(k), static_cast<int>(f));
+}
+
+WorldGuard::Key WorldGuard::key(int i, int j, int k) const {
+  auto part = [](int c) {
+    return static_cast<Key>(std::clamp(c + kCoordinateOffset, 0, (1 << kCoordinateBits) - 1));
+  };
+  return part(i) << (2 * kCoordinateBits) | part(j) << kCoordinateBits | part(k);
+}
+
+std::array<int, 3> WorldGuard::cell_of(const Vec3& p) const {
+  std::array<int, 3> c;
+  for (int d = 0; d < 3; ++d)
+    c[d] = static_cast<int>(std::clamp(std::floor(p[d] / cell_), -1e9, 1e9));
+  return c;
+}
+
+GuardTriangle WorldGuard::triangle(int mesh, int face) const {
+  const Mesh& m = *meshes_[mesh];
+  GuardTriangle t;
+  for (int i = 0; i < 3; ++i) {
+    const int n = m.face_node(face, i);
+    t.x[i] = m.nodes[n].x;
+    t.nodes[i] = mesh == 0 ? n : kNone;
+  }
+  return t;
+}
+
+void WorldGuard::insert(int mesh, int face) {
+  const GuardTriangle t = triangle(mesh, face);
+  const Eigen::AlignedBox3d b = box_of(t.x, 0);
+  if (!b.min().allFinite() || !b.max().allFinite()) return;
+  const std::array<int, 3> lo = cell_of(b.min()), hi = cell_of(b.max());
+  long cells = 1;
+  for (int d = 0; d < 3; ++d) cells *= hi[d] - lo[d] + 1;
+  const std::int64_t entry = static_cast<std::int64_t>(mesh) << 32 | face;
+  if (cells > kMaxCellsPerFace) {
+    large_.push_back(entry);
+    return;
+  }
+  for (int i = lo[0]; i <= hi[0]; ++i)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int k = lo[2]; k <= hi[2]; ++k) cells_[key(i, j, k)].push_back(entry);
+}
+
+void WorldGuard::update_face(int f) {
+  if (!mesh_.faces[f].dead) insert(0, f);
+}
+
+void WorldGuard::update_node(int n) {
+  for (int v : mesh_.nodes[n].verts)
+    for (int f : mesh_.verts[v].faces) update_face(f);
+}
+
+std::vector<int> WorldGuard::live_faces_around(int n) const {
+  std::vector<int> faces;
+  for (int v : mesh_.nodes[n].verts)
+    for (int f : mesh_.verts[v].faces)
+      if (!mesh_.faces[f].dead) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+std::vector<GuardTriangle> WorldGuard::fan(int n) const {
+  std::vector<GuardTriangle> triangles;
+  for (int f : live_faces_around(n)) triangles.push_back(triangle(0, f));
+  return triangles;
+}
+
+std::vector<GuardSweep> WorldGuard::fan_sweep(int n, const Vec3& from) const {
+  std::vector<GuardSweep> sweeps;
+  for (int f : live_faces_around(n)) {
+    const int c = mesh_.corner_of_node(f, n);
+    const int b0 = mesh_.face_node(f, (c + 1) % 3), b1 = mesh_.face_node(f, (c + 2) % 3);
+    sweeps.push_back({{from, mesh_.nodes[n].x, mesh_.nodes[b0].x, mesh_.nodes[b1].x}, {n, n, b0, b1}});
+  }
+  return sweeps;
+}
+
+std::vector<std::int64_t> WorldGuard::candidates(const Eigen::AlignedBox3d& box) const {
+  std::vector<std::int64_t> found(large_.begin(), large_.end());
+  const std::array<int, 3> lo = cell_of(box.min()), hi = cell_of(box.max());
+  for (int i = lo[0]; i <= hi[0]; ++i)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int k = lo[2]; k <= hi[2]; ++k) {
+        const auto it = cells_.find(key(i, j, k));
+        if (it != cells_.end()) found.insert(found.end(), it->second.begin(), it->second.end());
+      }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
+}
+
+bool WorldGuard::counts(std::int64_t entry, const int* nodes, int count, const std::vector<int>& replaced) const {
+  const int mesh = static_cast<int>(entry >> 32), face = static_cast<int>(entry & 0xffffffff);
+  if (mesh != 0) return true;
+  if (mesh_.faces[face].dead || std::binary_search(replaced.begin(), replaced.end(), face)) return false;
+  for (int i = 0; i < 3; ++i)
+    if (std::find(nodes, nodes + count, mesh_.face_node(face, i)) != nodes + count) return false;
+  return true;
+}
+
+double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced) const {
+  double nearest = clearance_;
+  for (const GuardTriangle& t : triangles) {
+    const Eigen::AlignedBox3d b = box_of(t.x, clearance_);
+    if (!b.min().allFinite() || !b.max().allFinite()) return 0;
+    for (const std::int64_t entry : candidates(b)) {
+      if (!counts(entry, t.nodes.data(), 3, replaced)) continue;
+      const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
+      if (!b.intersects(box_of(other.x, 0)) || ball_gap(t.x, other.x) >= nearest) continue;
+      nearest = std::min(nearest, triangle_separation(t.x, other.x));
+      if (nearest <= 0) return 0;
+    }
+  }
+  return nearest;
+}
+
+bool WorldGuard::sweep_is_clear(const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
+  for (const GuardSweep& s : sweeps) {
+    Eigen::AlignedBox3d b;
+    for (const Vec3& p : s.x) b.extend(p);
+    if (!b.min().allFinite() || !b.max().allFinite()) return false;
+    for (const std::int64_t entry : candidates(b)) {
+      if (!counts(entry, s.nodes.data(), 4, replaced)) continue;
+      const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
+      if (b.intersects(box_of(other.x, 0)) && ball_gap(other.x, s.x) <= 0 &&
+          triangle_meets_tetrahedron(other.x, s.x))
+        return false;
+    }
+  }
+  return true;
+}
+
+bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
+                        const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
+  std::vector<int> sorted = replaced;
+  std::sort(sorted.begin(), sorted.end());
+  if (!sweep_is_clear(sweeps, sorted)) return false;
+  const double gap_after = separation(after, sorted);
+  if (gap_after >= clearance_) return true;
+  return gap_after >= separation(before, sorted);
+}
+
+}  // namespace arcsim

@@ -1,0 +1,129 @@
+// The remeshing guard: edits may not make the world surface cross an obstacle or itself (remesh/world_guard).
+// A tent-shaped sheet (centre node raised) covers a small obstacle plate; coarsening wants to collapse the
+// centre, which would flatten the tent through the plate (or past it: the plate is small enough to end up
+// outside, uncrossed, which is as wrong). With the guard the plate stays under the sheet and clear of it;
+// without it the same pass crosses it or leaves it outside (so the test can tell).
+#include <gtest/gtest.h>
+
+#include "collision/tri_tri.hpp"
+#include "mesh/validate.hpp"
+#include "remesh/remesh.hpp"
+#include "remesh/remesh_fixtures.hpp"
+#include "remesh/world_guard.hpp"
+#include "support/mesh_factory.hpp"
+
+namespace arcsim {
+namespace {
+
+using remesh_test::cotton;
+using remesh_test::set_thickness;
+
+constexpr double kApex = 0.1;  // m, height of the tent's centre; the flattened tent lies at half of it
+
+Mesh tent() {
+  Mesh m = testing::make_grid(4, 4, 1.0, 1.0);
+  for (Node& n : m.nodes) {
+    const double r = std::max(std::abs(n.x.x() - 0.5), std::abs(n.x.y() - 0.5));
+    n.x.z() = n.x0.z() = kApex * std::max(0.0, 1 - 2 * r);
+  }
+  return m;
+}
+
+// A small horizontal plate under the apex, above the height the flattened tent would have.
+Mesh plate() {
+  const double z = 0.75 * kApex;
+  return remesh_test::mesh_from({Vec3(0.47, 0.47, z), Vec3(0.53, 0.47, z), Vec3(0.5, 0.53, z)}, {{0, 1, 2}});
+}
+
+// The plate is inside the tent: below the sheet over its centre.
+bool plate_under_sheet(const Mesh& sheet) {
+  for (size_t f = 0; f < sheet.faces.size(); ++f) {
+    if (sheet.faces[f].dead) continue;
+    std::array<Vec3, 3> x;
+    for (int i = 0; i < 3; ++i) x[i] = sheet.nodes[sheet.face_node(static_cast<int>(f), i)].x;
+    // Vertical ray up from the plate's centre.
+    const Vec3 p(0.5, 0.49, 0.75 * kApex);
+    const Vec3 n = (x[1] - x[0]).cross(x[2] - x[0]);
+    if (n.z() == 0) continue;
+    const double t = n.dot(x[0] - p) / n.z();
+    const Vec3 q = p + t * Vec3::UnitZ();
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) inside = inside && n.dot((x[(i + 1) % 3] - x[i]).cross(q - x[i])) >= 0;
+    if (inside) return t > 0;
+  }
+  return false;
+}
+
+int crossings(const Mesh& sheet, const Mesh& obstacle) {
+  int n = 0;
+  for (size_t f = 0; f < sheet.faces.size(); ++f) {
+    if (sheet.faces[f].dead) continue;
+    std::array<Vec3, 3> a, b;
+    for (int i = 0; i < 3; ++i) {
+      a[i] = sheet.nodes[sheet.face_node(static_cast<int>(f), i)].x;
+      b[i] = obstacle.nodes[obstacle.face_node(0, i)].x;
+    }
+    n += testing::triangles_intersect(a, b);
+  }
+  return n;
+}
+
+RemeshStats coarsen(Mesh& m, const Mesh& obstacle, double clearance) {
+  const std::vector<Material> materials{cotton()};
+  set_thickness(m, materials[0]);
+  RemeshOptions o;
+  o.extras.uniform_size = 10;    // every interior node is a collapse candidate
+  o.max_surface_change = 0;      // only the guard stands between the tent and the plate
+  o.reproject = false;
+  o.world_clearance = clearance;
+  o.obstacles = {&obstacle};
+  return remesh_mesh(m, materials, o);
+}
+
+TEST(WorldGuard, CoarseningDoesNotFlattenTheSheetThroughAnObstacle) {
+  const Mesh obstacle = plate();
+  Mesh unguarded = tent();
+  ASSERT_EQ(crossings(unguarded, obstacle), 0);
+  const RemeshStats free = coarsen(unguarded, obstacle, 0);
+  EXPECT_GT(free.collapses, 0);
+  EXPECT_TRUE(crossings(unguarded, obstacle) > 0 || !plate_under_sheet(unguarded))
+      << "the unguarded pass should cross the plate or leave it outside";
+
+  Mesh guarded = tent();
+  const RemeshStats s = coarsen(guarded, obstacle, 1e-4);
+  EXPECT_EQ(check_mesh(guarded), "");
+  EXPECT_GT(s.collapses, 0) << "edits away from the plate still happen";
+  EXPECT_GT(s.guarded, 0);
+  EXPECT_EQ(crossings(guarded, obstacle), 0);
+  EXPECT_TRUE(plate_under_sheet(guarded));
+  // The plate keeps the clearance from the sheet.
+  const WorldGuard probe(guarded, {}, 1.0);
+  std::vector<GuardTriangle> plate_triangle(1);
+  for (int i = 0; i < 3; ++i) plate_triangle[0].x[i] = obstacle.nodes[i].x;
+  EXPECT_GE(probe.separation(plate_triangle, {}), 1e-4);
+}
+
+TEST(WorldGuard, AllowsEditsThatComeNoCloserThanBefore) {
+  const Mesh sheet = testing::make_grid(2, 2, 1.0, 1.0, testing::Diagonal::kForward, 10, 10);  // far away
+  const Mesh obstacle = remesh_test::mesh_from({Vec3(0, 0, 1e-5), Vec3(1, 0, 1e-5), Vec3(0, 1, 1e-5)}, {{0, 1, 2}});
+  const WorldGuard guard(sheet, {&obstacle}, 1e-4);
+  GuardTriangle low, lower, high;
+  low.x = {Vec3(0.2, 0.2, 0), Vec3(0.4, 0.2, 0), Vec3(0.2, 0.4, 0)};
+  lower = low;
+  for (Vec3& p : lower.x) p.z() = 5e-6;
+  high = low;
+  for (Vec3& p : high.x) p.z() = -1e-3;
+  EXPECT_NEAR(guard.separation({low}, {}), 1e-5, 1e-15);
+  EXPECT_TRUE(guard.allows({low}, {high}, {}, {}));   // moves away beyond the clearance
+  EXPECT_TRUE(guard.allows({low}, {low}, {}, {}));    // already closer than the clearance, no closer
+  EXPECT_FALSE(guard.allows({low}, {lower}, {}, {})); // closer still
+  // Moving through the obstacle to the far side is refused although the end is clear.
+  GuardTriangle through = low;
+  for (Vec3& p : through.x) p.z() = 1e-3;
+  GuardSweep sweep{{low.x[0], through.x[0], low.x[1], low.x[2]}, {}};
+  EXPECT_FALSE(guard.allows({low}, {through}, {sweep}, {}));
+  EXPECT_TRUE(guard.allows({low}, {high}, {GuardSweep{{low.x[0], high.x[0], low.x[1], low.x[2]}, {}}}, {}));
+}
+
+}  // namespace
+}  // namespace arcsim
