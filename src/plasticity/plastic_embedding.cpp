@@ -275,7 +275,12 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& m, const std::vector<Material>
       const int wing = live_face(m, other) ? m.opposite_node(face.e[i], other) : kNone;
       has_wing[i] = wing != kNone && emb.has(wing);
       nodes[3 + i] = has_wing[i] ? wing : nodes[0];
-      rest[i] = m.rest_dihedral(face.e[i]);
+      // Against the edge's plastic angle theta^p (what the edit gave it: a split's halves keep the old hinge's,
+      // its new edges inside the old faces are flat), not the paper's reference theta^R, which pulls every
+      // placed node towards the flat reference (a split along a fold line of a uniformly curved plastic sheet
+      // moved its node off the fold: 5e-3 rad of world / rest mismatch, tests/plasticity/
+      // plastic_embedding_test.cpp's patch test).
+      rest[i] = m.edges[face.e[i]].rest_theta;
     }
     const Mat3 Q = bending_matrix(m, materials[face.material], f, has_wing);
     std::array<Vec3, 6> xs;
@@ -296,7 +301,7 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& m, const std::vector<Material>
 }
 
 int place_node_in_embedding(const Mesh& m, const std::vector<Material>& materials, PlasticEmbedding& emb,
-                            int node, int max_iterations) {
+                            int node, int max_iterations, const Vec3& frozen_direction) {
   if (!emb.has(node)) return 0;
   double length = 0;
   int count = 0;
@@ -315,7 +320,17 @@ int place_node_in_embedding(const Mesh& m, const std::vector<Material>& material
   for (int it = 0; it < max_iterations; ++it) {
     const Mat3& H = current.hessian;
     const double reg = 1e-10 * std::max(H.trace() / 3, 0.0) + 1e-300;
-    Vec3 step = -(H + reg * Mat3::Identity()).ldlt().solve(current.gradient);
+    Vec3 step = Vec3::Zero();
+    if (frozen_direction.isZero(0)) {
+      step = -(H + reg * Mat3::Identity()).ldlt().solve(current.gradient);
+    } else {
+      // Newton in the plane across the frozen direction (basis B): step = -B (B^T H B)^-1 B^T g.
+      const Vec3 t1 = frozen_direction.unitOrthogonal(), t2 = frozen_direction.cross(t1);
+      Eigen::Matrix<double, 3, 2> B;
+      B << t1, t2;
+      const Mat2 H2 = B.transpose() * H * B + reg * Mat2::Identity();
+      step = -B * H2.ldlt().solve(B.transpose() * current.gradient);
+    }
     if (!step.allFinite() || step.dot(current.gradient) >= 0) break;
     // The quadratic model is not trusted beyond the neighbourhood's size.
     if (step.norm() > 0.5 * length) step *= 0.5 * length / step.norm();
@@ -333,6 +348,76 @@ int place_node_in_embedding(const Mesh& m, const std::vector<Material>& material
   }
   emb.set(node, y);
   return accepted_steps;
+}
+
+int place_split_node_in_embedding(const Mesh& m, const std::vector<Material>& materials, PlasticEmbedding& emb,
+                                  int node, int end0, int end1) {
+  if (!emb.has(end0) || !emb.has(end1)) return 0;
+  const Vec3 ya = emb.at(end0), yb = emb.at(end1);
+  const Vec3 middle = 0.5 * (ya + yb);
+  emb.set(node, middle);
+  Vec3 normal = Vec3::Zero();
+  Mat3 S = Mat3::Zero();
+  Vec3 e = Vec3::Zero();
+  double area = 0;
+  int halves = 0;
+  std::vector<int> wings;
+  for (int f : node_faces(m, node)) {
+    if (!face_embedded(m, emb, f)) continue;
+    const Face& face = m.faces[f];
+    const Vec3 y0 = emb.at(m.face_node(f, 0)), y1 = emb.at(m.face_node(f, 1)), y2 = emb.at(m.face_node(f, 2));
+    normal += (y1 - y0).cross(y2 - y0);
+    area += face.rest_area;
+    const int c = m.corner_of_node(f, node);
+    for (int k = 1; k <= 2; ++k) {
+      const int other = m.face_node(f, (c + k) % 3);
+      if (other == end0) e -= m.verts[face.v[(c + k) % 3]].u - m.verts[face.v[c]].u, ++halves;
+      if (other == end1) e += m.verts[face.v[(c + k) % 3]].u - m.verts[face.v[c]].u, ++halves;
+    }
+    // Wings across the face's edges that do not touch the new node: where the neighbourhood bends to.
+    const int across = m.other_face(face.e[(c + 1) % 3], f);
+    if (live_face(m, across)) wings.push_back(m.opposite_node(face.e[(c + 1) % 3], across));
+  }
+  if (!(area > 0) || !(normal.norm() > 0)) return 0;
+  normal.normalize();
+  // Plastic curvature S (1/m) around the split from the edges' plastic offsets (the rest angles are the truth; a
+  // face's Sp is not uniform even on a uniformly bent sheet), over the split faces and their flaps (the split
+  // faces alone see no hinge where they touch the sheet's boundary): sum of offset l n n^T, inner edges whole
+  // and edges on the region's border half, over the region's area.
+  std::vector<int> region;
+  for (int f : faces_with_flaps(m, node_faces(m, node)))
+    if (face_embedded(m, emb, f)) region.push_back(f);
+  region = sorted_unique(region);
+  double region_area = 0;
+  for (int f : region) region_area += m.faces[f].rest_area;
+  std::vector<int> edges;
+  for (int f : region) edges.insert(edges.end(), m.faces[f].e.begin(), m.faces[f].e.end());
+  for (int ed : sorted_unique(edges)) {
+    const Edge& edge = m.edges[ed];
+    if (edge.is_boundary()) continue;
+    const double offset = edge.rest_theta - m.rest_dihedral(ed);
+    if (offset == 0) continue;
+    const bool inner = std::binary_search(region.begin(), region.end(), edge.f[0]) &&
+                       std::binary_search(region.begin(), region.end(), edge.f[1]);
+    const int f = std::binary_search(region.begin(), region.end(), edge.f[0]) ? edge.f[0] : edge.f[1];
+    const Face& face = m.faces[f];
+    const Vec3 d = m.verts[face.v[m.corner_of_node(f, edge.n[1])]].u -
+                   m.verts[face.v[m.corner_of_node(f, edge.n[0])]].u;
+    const double l = d.norm();
+    if (!(l > 0)) continue;
+    const Vec3 n = d.cross(face.rest_normal) / l;
+    S += (inner ? 1.0 : 0.5) * offset * l * n * n.transpose();
+  }
+  S /= region_area;
+  // e summed one half of the split edge per face: back to the whole edge's rest vector (m).
+  e *= 2.0 / std::max(halves, 1);
+  const double bulge = 0.125 * std::abs(e.dot(S * e));  // m
+  // The neighbours across the faces' outer edges lie on the concave side: the node goes to the other.
+  double side = 0;
+  for (int w : wings)
+    if (emb.has(w)) side += (emb.at(w) - middle).dot(normal);
+  if (bulge > 0 && side != 0) emb.set(node, middle - (side > 0 ? 1 : -1) * bulge * normal);
+  return place_node_in_embedding(m, materials, emb, node, 6, normal);
 }
 
 Vec3 world_position_from_embedding(const Mesh& m, const PlasticEmbedding& emb, int node) {

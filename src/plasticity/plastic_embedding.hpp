@@ -4,18 +4,19 @@
 // Before an edit, the faces it will replace and the faces across their edges ("flaps") are unfolded into a
 // 3D plastic space, one hinge at a time: every face keeps its plastic edge lengths (plastic edge vectors are
 // Fp2^-1 e, see plastic_tensors.hpp: F_el = F Fp) and every hinge its plastic angle theta^p = Edge::rest_theta.
-// After the edit, a new node (split) is placed by a few Gauss-Newton steps on the plastic energy E_p of Eq. 12
-// with every other node fixed; then Fp and Sp of the new faces are read back from the embedding (Eq. 11): Fp
-// from the plastic metric of the embedded triangle, Sp from its three embedded dihedral angles.
+// After the edit, a new node (split) is placed on the smooth surface the neighbourhood's plastic curvature
+// describes (off the old faces' plane by the sagitta of the split edge) and settles within that plane by a few
+// Gauss-Newton steps on the plastic energy E_p of Eq. 12 with every other node fixed (place_split_node_in_
+// embedding says why not by Eq. 12 alone); then Fp and Sp of the new faces are read back from the embedding
+// (Eq. 11): Fp from the plastic metric of the embedded triangle, Sp from its three embedded dihedral angles.
 //
 // Eq. 12 as implemented, for the node's faces and the faces that have it as a bending wing:
-//   E_p(y) = sum_faces A/2 G^p : sigma^p  +  plate bending of the embedded dihedrals against theta^R,
+//   E_p(y) = sum_faces A/2 G^p : sigma^p  +  plate bending of the embedded dihedrals against theta^p,
 // with G^p the Green strain of the embedded triangle against the reference metric (the paper's Eq. 12) and
-// theta^R the geometric rest dihedral. The reference metric pulls a node refined on a curved plastic surface
-// out to where its new edges regain their rest lengths, i.e. onto the smooth surface instead of the chord of the
-// old edge (coarsening would otherwise cut that surface down cycle after cycle). Faces of a material with a
-// stretching flow rule measure G^p against their plastic metric (the Fp the edit gave them) instead: there the
-// reference would pull a boundary node of a plastically stretched sheet inwards.
+// theta^p the edges' plastic angles (Edge::rest_theta; the paper writes theta^R, which pulls every placed node
+// towards the flat reference: a uniformly curved plastic sheet was not reproduced by a split). Faces of a
+// material with a stretching flow rule measure G^p against their plastic metric (the Fp the edit gave them)
+// instead: there the reference would pull a boundary node of a plastically stretched sheet inwards.
 //
 // Multi-material: only faces of plastic materials (finite yield_curv, or a stretching flow rule) are rebuilt;
 // every other face keeps Fp and Sp exactly as the edit left them (copied from a parent of the same material).
@@ -65,9 +66,23 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& mesh, const std::vector<Materi
                                       HessianKind hessian);
 
 // Moves the node's plastic position to the minimiser of plastic_node_energy by damped Gauss-Newton steps with
-// a backtracking line search. Returns the number of accepted steps.
+// a backtracking line search; with a non-zero `frozen_direction` (unit) only across it. Returns the number of
+// accepted steps.
 int place_node_in_embedding(const Mesh& mesh, const std::vector<Material>& materials,
-                            PlasticEmbedding& embedding, int node, int max_iterations = 6);
+                            PlasticEmbedding& embedding, int node, int max_iterations = 6,
+                            const Vec3& frozen_direction = Vec3::Zero());
+
+// Places the node a split of edge (end0, end1) created. Off the plane of the split faces it goes where their
+// plastic curvature puts it: the middle of the embedded edge plus the sagitta e^T S e / 8 of the edge e under
+// the plastic curvature S estimated from the neighbourhood's edge offsets (rest angles), on the convex side.
+// Within that plane it settles by Gauss-Newton on Eq. 12. WHY not Eq. 12 alone: the middle of a flat coarse
+// face spanning a curved plastic region is a saddle of the membrane term (no gradient across the plane), and
+// where Eq. 12 moves the node off it depends on the metric it measures against (the reference one over-bulges,
+// the coarse face's chord metric does not bulge at all); either way every refine / coarsen cycle bent the sheet
+// a little more or less (measured: -0.7% .. -2% of a constant-curvature arc in 10 cycles). Returns the accepted
+// Gauss-Newton steps.
+int place_split_node_in_embedding(const Mesh& mesh, const std::vector<Material>& materials,
+                                  PlasticEmbedding& embedding, int node, int end0, int end1);
 
 // World position of an embedded node that keeps its plastic neighbourhood's shape: the best rigid map of its
 // embedded neighbours onto their world positions, applied to it (a starting point for the world reprojection,

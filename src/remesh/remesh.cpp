@@ -1,6 +1,7 @@
 #include "remesh/remesh.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -76,6 +77,31 @@ Mat3 rest_to_world_map(const Mesh& m, int f) {
   return map.allFinite() ? map : Mat3::Identity();
 }
 
+// Rest-side positions of a neighbourhood against which max_surface_change measures the world's change: the
+// nodes' rest positions u, or, where the faces (and their flaps) hold plastic state, their local plastic
+// embedding (only distances are compared, so its arbitrary placement does not matter).
+class RestSidePositions {
+ public:
+  RestSidePositions(const Mesh& m, const std::vector<Material>* materials, const std::vector<int>& faces)
+      : m_(m) {
+    if (materials != nullptr && neighbourhood_has_plasticity(m, *materials, faces)) {
+      embedding_ = build_plastic_embedding(m, faces);
+      plastic_ = true;
+    }
+  }
+  bool plastic() const { return plastic_; }
+  // Position of node n, seen from face f (the vert of n in f gives u).
+  Vec3 at(int n, int f) const {
+    if (plastic_ && embedding_.has(n)) return embedding_.at(n);
+    return m_.verts[vert_at(m_, f, n)].u;
+  }
+
+ private:
+  const Mesh& m_;
+  PlasticEmbedding embedding_;
+  bool plastic_ = false;
+};
+
 }  // namespace
 
 double triangle_aspect(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -85,7 +111,8 @@ double triangle_aspect(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 12 * std::sqrt(3.0) * area / (perimeter * perimeter);
 }
 
-bool should_flip(const Mesh& m, int e, double threshold, double max_surface_change) {
+bool should_flip(const Mesh& m, int e, double threshold, double max_surface_change,
+                 const std::vector<Material>* materials) {
   const Edge& edge = m.edges[e];
   if (edge.dead || edge.is_boundary() || edge.preserve) return false;
   const int f0 = edge.f[0], f1 = edge.f[1];
@@ -140,7 +167,10 @@ bool should_flip(const Mesh& m, int e, double threshold, double max_surface_chan
       const Vec3 across = (b - a).cross(d - c);
       return across.norm() > 0 ? std::abs((c - a).dot(across)) / across.norm() : 0.0;
     };
-    const double change = std::abs(gap(xi, xj, xk, xl) - gap(Ui, Uj, Uk, Ul));
+    const RestSidePositions rest(m, materials, {f0, f1});
+    const double rest_gap = rest.plastic() ? gap(rest.at(i, f0), rest.at(j, f0), rest.at(k, f0), rest.at(l, f1))
+                                           : gap(Ui, Uj, Uk, Ul);
+    const double change = std::abs(gap(xi, xj, xk, xl) - rest_gap);
     if (change > max_surface_change * (Uj - Ui).norm()) return false;
   }
   return true;
@@ -351,9 +381,21 @@ class Remesher {
 
   // --- plastic transfer (paper §5.2) ----------------------------------------------------------------------
 
+  // Adds the wall time since `start` to the plastic transfer's total.
+  void add_plastic_time(std::chrono::steady_clock::time_point start) {
+    stats_.plastic_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
   // Before an edit of `faces`: true if they hold plastic state to transfer; with the embedding transfer, their
   // plastic embedding is built into `embedding`.
-  bool capture_plastic(const std::vector<int>& faces, PlasticEmbedding& embedding) const {
+  bool capture_plastic(const std::vector<int>& faces, PlasticEmbedding& embedding) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool plastic = capture_plastic_state(faces, embedding);
+    add_plastic_time(start);
+    return plastic;
+  }
+
+  bool capture_plastic_state(const std::vector<int>& faces, PlasticEmbedding& embedding) const {
     std::vector<int> live;
     for (int f : faces)
       if (f != kNone) live.push_back(f);
@@ -366,11 +408,13 @@ class Remesher {
   // embedding or, with "plastic_transfer": "interpolate", from the edit's interpolated Sp.
   void transfer_plastic(const EditResult& r, bool plastic, const PlasticEmbedding& embedding) {
     if (!plastic) return;
+    const auto start = std::chrono::steady_clock::now();
     if (o_.sizing.remeshing.plastic_embedding) {
       rebuild_plasticity_from_embedding(m_, materials_, embedding, r.added_faces);
     } else {
       interpolate_plasticity(m_, materials_, r.added_faces);
     }
+    add_plastic_time(start);
   }
 
   // --- flips ------------------------------------------------------------------------------------------------
@@ -391,7 +435,7 @@ class Remesher {
           next.push_back(e);
           continue;
         }
-        if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change)) continue;
+        if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change, &materials_)) continue;
         if (!guard_allows_flip(e)) {
           ++stats_.guarded;
           continue;
@@ -508,12 +552,23 @@ class Remesher {
       }
     }
     if (plastic && embedding.has(end0) && embedding.has(end1)) {
-      // Paper §5.2: the new node starts at the middle of the embedded edge and settles by Eq. 12.
-      embedding.set(node, 0.5 * (embedding.at(end0) + embedding.at(end1)));
-      place_node_in_embedding(m_, materials_, embedding, node);
-      const Vec3 shift = world_position_from_embedding(m_, embedding, node) - m_.nodes[node].x;
-      m_.nodes[node].x += shift;
-      m_.nodes[node].x0 += shift;
+      // Paper §5.2: the new node goes onto the plastic surface in the embedding (place_split_node_in_embedding
+      // says how); its world position follows the embedded neighbourhood's shape.
+      const auto start = std::chrono::steady_clock::now();
+      place_split_node_in_embedding(m_, materials_, embedding, node, end0, end1);
+      Vec3 shift = world_position_from_embedding(m_, embedding, node) - m_.nodes[node].x;
+      add_plastic_time(start);
+      // The node moves no farther than the reprojection may move it across the sheet (max_displacement); the
+      // reprojection that follows is free within the sheet. WHY: the world can be bent further than the plastic
+      // shape (a sheet pressed around an obstacle), and moving a new node fully onto the plastic shape carried
+      // it into the obstacle (measured on conf/metal-crumple-remesh.json: 18 cloth / sphere edge crossings after
+      // the first refining frame without reprojection; a limit on the motion along the normal alone left them).
+      const double limit = o_.reprojection.max_displacement;
+      if (shift.norm() > limit) shift *= limit / shift.norm();
+      if (shift.allFinite()) {
+        m_.nodes[node].x += shift;
+        m_.nodes[node].x0 += shift;
+      }
     }
     keep_move(node, flat, mid_x, mid_x0);
     transfer_plastic(r, plastic, embedding);
@@ -563,7 +618,9 @@ class Remesher {
     if (m_.is_boundary_node(gone) && !boundary_node_on_chord(gone)) return false;
     const Vec3& x_keep = m_.nodes[keep].x;
     double gone_to_surface = kInfinity, gone_to_rest_surface = kInfinity;  // m
-    for (int f : node_faces(m_, gone)) {
+    const std::vector<int> fan = node_faces(m_, gone);
+    const RestSidePositions rest(m_, o_.max_surface_change > 0 ? &materials_ : nullptr, fan);
+    for (int f : fan) {
       if (f == edge.f[0] || f == edge.f[1]) continue;
       const Face& face = m_.faces[f];
       const int c = m_.corner_of_node(f, gone);
@@ -586,8 +643,16 @@ class Remesher {
       for (int k = 1; k <= 2; ++k)
         if (vert_pair_metric_length(m_, it->second, nv[(c + k) % 3]) > kCollapseMetricLimit) return false;
       gone_to_surface = std::min(gone_to_surface, vertex_face_closest(g.x, x[0], x[1], x[2]).distance);
-      gone_to_rest_surface =
-          std::min(gone_to_rest_surface, vertex_face_closest(m_.verts[face.v[c]].u, u0, u1, u2).distance);
+      if (rest.plastic()) {
+        // The same face in the plastic shape: its corners' embedded positions, the removed one replaced by keep.
+        std::array<Vec3, 3> y;
+        for (int i = 0; i < 3; ++i) y[i] = rest.at(i == c ? keep : m_.face_node(f, i), f);
+        gone_to_rest_surface =
+            std::min(gone_to_rest_surface, vertex_face_closest(rest.at(gone, f), y[0], y[1], y[2]).distance);
+      } else {
+        gone_to_rest_surface =
+            std::min(gone_to_rest_surface, vertex_face_closest(m_.verts[face.v[c]].u, u0, u1, u2).distance);
+      }
     }
     // The removed node's distance to the faces that replace its fan bounds how far the surface moves; the part
     // the rest shape has too (a curved rest surface being coarsened) is no elastic change.

@@ -32,7 +32,8 @@ struct RemeshOptions {
   const ReferenceSurface* reference = nullptr;  // where new rest positions go; nullptr: left on the chord
   bool reproject = true;               // world-space reprojection after every split / collapse
   ReprojectionParams reprojection;
-  // Collapses and flips may change the world surface, beyond what the rest surface changes, by at most this
+  // Collapses and flips may change the world surface, beyond what the rest surface changes (the plastic shape
+  // where the neighbourhood holds plastic state, see should_flip), by at most this
   // fraction of the edge's rest length: the removed node's distance to the new faces, the distance between the
   // quad's diagonals (world minus rest). WHY: the sizing lets an edge bend by up to refine_angle, and flattening
   // such a wrinkle in one remesh is a visible pop (ARCSim's square-pop scene). <= 0: no limit.
@@ -48,6 +49,9 @@ struct RemeshOptions {
 struct RemeshStats {
   int splits = 0, flips = 0, collapses = 0, reprojections = 0;
   int guarded = 0;  // edits and node moves refused (or undone) by the world-space guard
+  // Wall time (s) of the plastic transfer inside the pass: building embeddings, placing split nodes in them and
+  // rebuilding Fp / Sp (or interpolating), for the benchmarks. Included in the pass's total time.
+  double plastic_seconds = 0;
   // Live faces of the active region after the pass: the subset's surviving faces plus every face created
   // (all live faces when no subset was given). Indices before compaction.
   std::vector<int> active_faces;
@@ -61,8 +65,11 @@ RemeshStats remesh_mesh(Mesh& mesh, const std::vector<Material>& materials, cons
 // Anisotropic Delaunay test of an interior edge (Bossen-Heckbert) in the mean metric of its four verts, with the
 // flip restrictions of facts §5.3 (no boundary / seam / preserved edge, world dihedral and flipped rest and
 // world dihedral below 40 degrees, no world-space inversion) and the world-surface limit (see
-// RemeshOptions::max_surface_change). Uses the verts' current sizing.
-bool should_flip(const Mesh& mesh, int edge, double threshold, double max_surface_change = 0);
+// RemeshOptions::max_surface_change). Uses the verts' current sizing. With `materials`, a neighbourhood holding
+// plastic state measures the surface change against its plastic shape (the local plastic embedding) instead of
+// the rest positions: a plastically bent sheet rests in that shape, not in its flat reference.
+bool should_flip(const Mesh& mesh, int edge, double threshold, double max_surface_change = 0,
+                 const std::vector<Material>* materials = nullptr);
 
 // Mean ratio quality 12 sqrt(3) area / perimeter^2 of a triangle (1 for equilateral, 0 for degenerate).
 double triangle_aspect(const Vec3& a, const Vec3& b, const Vec3& c);

@@ -166,8 +166,7 @@ EditResult split_with_embedding(Mesh& m, const std::vector<Material>& materials,
   const EditResult r = split_edge(m, edge, 0.5);
   if (!r.ok) return r;
   const int node = r.added_nodes[0];
-  emb.set(node, 0.5 * (emb.at(a) + emb.at(b)));
-  place_node_in_embedding(m, materials, emb, node);
+  place_split_node_in_embedding(m, materials, emb, node, a, b);
   rebuild_plasticity_from_embedding(m, materials, emb, r.added_faces);
   return r;
 }
@@ -247,6 +246,145 @@ TEST(PlasticEmbedding, FlipKeepsAPlasticFold) {
     } else {
       std::printf("flip of a folded square: interpolated rest angle %.6f vs fold %.6f rad\n", rest, world);
     }
+  }
+}
+
+// A sheet bent plastically into a cylinder about y: uniform Sp = kappa x x^T on a grid of 0.05 m cells (on this
+// grid its edge offsets are kappa * 0.05 on every line x = const and 0 elsewhere), the world at rest on it (a
+// polygon through the fold lines). Bending plasticity only.
+Mesh uniformly_bent_sheet(double kappa, const Material& mat) {
+  const double cell = 0.05;
+  Mesh m = make_grid(4, 4, 4 * cell, 4 * cell);
+  set_material_thickness(m, mat);
+  set_uniform_Sp(m, kappa);
+  const double fold = kappa * cell;
+  for (Node& n : m.nodes) {
+    const double k = n.x.x() / cell;
+    const int i = static_cast<int>(std::floor(k + 1e-9));
+    Vec2 p = Vec2::Zero();
+    for (int j = 0; j < i; ++j) p += cell * Vec2(std::cos(j * fold), std::sin(j * fold));
+    p += (k - i) * cell * Vec2(std::cos(i * fold), std::sin(i * fold));
+    n.x = n.x0 = Vec3(p.x(), n.x.y(), p.y());
+  }
+  // The polygon turns the way the rest angles say (flip it if the sign convention disagrees).
+  for (size_t e = 0; e < m.edges.size(); ++e)
+    if (!m.edges[e].is_boundary() && std::abs(m.edges[e].rest_theta) > 0 &&
+        std::abs(m.world_dihedral(static_cast<int>(e)) - m.edges[e].rest_theta) > 1e-9) {
+      for (Node& n : m.nodes) n.x.z() = n.x0.z() = -n.x.z();
+      break;
+    }
+  return m;
+}
+
+// Largest |world dihedral - rest angle| over interior edges (rad): 0 while the plastic shape is the world's.
+double world_rest_mismatch(const Mesh& m) {
+  double worst = 0;
+  for (size_t e = 0; e < m.edges.size(); ++e)
+    if (!m.edges[e].dead && !m.edges[e].is_boundary())
+      worst = std::max(worst, std::abs(m.world_dihedral(static_cast<int>(e)) - m.edges[e].rest_theta));
+  return worst;
+}
+
+// Area integral of Sp over the live faces (1/m * m^2).
+Mat3 integrated_Sp(const Mesh& m) {
+  Mat3 sum = Mat3::Zero();
+  for (const Face& f : m.faces)
+    if (!f.dead) sum += f.rest_area * f.Sp;
+  return sum;
+}
+
+// Edge between the nodes nearest to rest points a and b (kNone if they are not joined).
+int edge_near(const Mesh& m, const Vec2& a, const Vec2& b) {
+  auto nearest = [&](const Vec2& p) {
+    int best = kNone;
+    double d = kInfinity;
+    for (size_t n = 0; n < m.nodes.size(); ++n) {
+      if (m.nodes[n].dead) continue;
+      const double dn = (m.verts[m.nodes[n].verts[0]].u.head<2>() - p).norm();
+      if (dn < d) d = dn, best = static_cast<int>(n);
+    }
+    return best;
+  };
+  return m.find_edge(nearest(a), nearest(b));
+}
+
+TEST(PlasticEmbedding, PatchTestUniformCurvatureSurvivesSplitFlipCollapse) {
+  // The embedding's consistency check on a uniformly curved plastic sheet at rest (kappa = 2 1/m folded every
+  // 0.05 m): a split along a fold line, across the folds and diagonal to them, a flip and a collapse along a
+  // fold line. After each, with the world node placed as remeshing places it (world_position_from_embedding),
+  // the world must rest on the new plastic state (every rest angle equal to the world dihedral) and the area
+  // integral of Sp must be kept: exactly where nothing bends off the old faces (split along a fold line, flip,
+  // collapse), to the sagitta order where a split bulges the node onto the smooth cylinder the folds sample
+  // (|kappa| l^2 / 8 = 2.5e-3 of a 0.05 m edge; the polygon itself is flat between folds). Per-face Sp does not
+  // stay uniform (a face owns its edges' offsets, so halving a face next to a fold doubles its Sp); its
+  // integral does.
+  const std::vector<Material> materials{[] {
+    Material m = aluminium();
+    m.yield_stress = kInfinity;  // bending plasticity only
+    m.flow_rate = 0;
+    return m;
+  }()};
+  const double kappa = 2.0;  // 1/m
+  Mesh m = uniformly_bent_sheet(kappa, materials[0]);
+  ASSERT_LT(world_rest_mismatch(m), 1e-12);
+  const Mat3 integral = integrated_Sp(m);
+  ASSERT_NEAR(integral(0, 0), kappa * 0.04, 1e-12);
+  auto check = [&](const char* what, double tolerance) {
+    EXPECT_LT(world_rest_mismatch(m), 1e-9) << what;
+    EXPECT_LT((integrated_Sp(m) - integral).norm(), tolerance * integral.norm()) << what;
+  };
+
+  struct SplitCase {
+    Vec2 a, b;
+    double tolerance;  // relative change of the Sp integral
+    const char* what;
+  };
+  for (const SplitCase& c : {SplitCase{Vec2(0.05, 0.05), Vec2(0.05, 0.10), 1e-9, "split along a fold line"},
+                             SplitCase{Vec2(0.10, 0.10), Vec2(0.15, 0.10), 1e-2, "split across the folds"},
+                             SplitCase{Vec2(0.10, 0.05), Vec2(0.15, 0.10), 1e-2, "diagonal split"}}) {
+    const int e = edge_near(m, c.a, c.b);
+    ASSERT_NE(e, kNone);
+    const int n0 = m.edges[e].n[0], n1 = m.edges[e].n[1];
+    std::vector<int> faces;
+    for (int f : m.edges[e].f)
+      if (f != kNone) faces.push_back(f);
+    PlasticEmbedding emb = build_plastic_embedding(m, faces);
+    const EditResult r = split_edge(m, e, 0.5);
+    ASSERT_TRUE(r.ok);
+    const int node = r.added_nodes[0];
+    place_split_node_in_embedding(m, materials, emb, node, n0, n1);
+    rebuild_plasticity_from_embedding(m, materials, emb, r.added_faces);
+    m.nodes[node].x = world_position_from_embedding(m, emb, node);
+    check(c.what, c.tolerance);
+  }
+  // Flip a cell's diagonal (both faces in one plane of the cylinder).
+  {
+    const int e = edge_near(m, Vec2(0.15, 0.15), Vec2(0.10, 0.20));
+    const int other = edge_near(m, Vec2(0.10, 0.15), Vec2(0.15, 0.20));
+    const int diagonal = e != kNone ? e : other;
+    ASSERT_NE(diagonal, kNone);
+    const PlasticEmbedding emb = build_plastic_embedding(m, {m.edges[diagonal].f[0], m.edges[diagonal].f[1]});
+    const EditResult r = flip_edge(m, diagonal);
+    ASSERT_TRUE(r.ok);
+    rebuild_plasticity_from_embedding(m, materials, emb, r.added_faces);
+    check("flip", 1e-2);
+  }
+  // Collapse the split node on the fold line x = 0.05 into an end of its edge (it stays on the fold line).
+  {
+    const int e = edge_near(m, Vec2(0.05, 0.075), Vec2(0.05, 0.10));
+    ASSERT_NE(e, kNone);
+    int side = kNone;
+    for (int s = 0; s < 2; ++s)
+      if (std::abs(m.verts[m.nodes[m.edges[e].n[s]].verts[0]].u.y() - 0.075) < 1e-9) side = s;
+    ASSERT_NE(side, kNone);
+    std::vector<int> faces;
+    for (int v : m.nodes[m.edges[e].n[side]].verts)
+      for (int f : m.verts[v].faces) faces.push_back(f);
+    const PlasticEmbedding emb = build_plastic_embedding(m, faces);
+    const EditResult r = collapse_edge(m, e, side);
+    ASSERT_TRUE(r.ok);
+    rebuild_plasticity_from_embedding(m, materials, emb, r.added_faces);
+    check("collapse", 1e-2);
   }
 }
 
