@@ -5,9 +5,9 @@
 // 3D plastic space, one hinge at a time: every face keeps its plastic edge lengths (plastic edge vectors are
 // Fp2^-1 e, see plastic_tensors.hpp: F_el = F Fp) and every hinge its plastic angle theta^p = Edge::rest_theta.
 // After the edit, a new node (split) is placed on the smooth surface the neighbourhood's plastic curvature
-// describes (off the old faces' plane by the sagitta of the split edge) and settles within that plane by a few
-// Gauss-Newton steps on the plastic energy E_p of Eq. 12 with every other node fixed (place_split_node_in_
-// embedding says why not by Eq. 12 alone); then Fp and Sp of the new faces are read back from the embedding
+// describes (off the old faces' plane by the sagitta of the split edge) and settles from there by Gauss-Newton
+// steps on the plastic energy E_p of Eq. 12 with every other node fixed (place_split_node_in_embedding says why
+// it does not start on the chord); then Fp and Sp of the new faces are read back from the embedding
 // (Eq. 11): Fp from the plastic metric of the embedded triangle, Sp from its three embedded dihedral angles.
 //
 // Eq. 12 as implemented, for the node's faces and the faces that have it as a bending wing:
@@ -66,21 +66,19 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& mesh, const std::vector<Materi
                                       HessianKind hessian);
 
 // Moves the node's plastic position to the minimiser of plastic_node_energy by damped Gauss-Newton steps with
-// a backtracking line search; with a non-zero `frozen_direction` (unit) only across it. Returns the number of
-// accepted steps.
+// a backtracking line search. Returns the number of accepted steps.
 int place_node_in_embedding(const Mesh& mesh, const std::vector<Material>& materials,
-                            PlasticEmbedding& embedding, int node, int max_iterations = 6,
-                            const Vec3& frozen_direction = Vec3::Zero());
+                            PlasticEmbedding& embedding, int node, int max_iterations = 6);
 
-// Places the node a split of edge (end0, end1) created. Off the plane of the split faces it goes where their
-// plastic curvature puts it: the middle of the embedded edge plus the sagitta e^T S e / 8 of the edge e under
-// the plastic curvature S estimated from the neighbourhood's edge offsets (rest angles), on the convex side.
-// Within that plane it settles by Gauss-Newton on Eq. 12. WHY not Eq. 12 alone: the middle of a flat coarse
-// face spanning a curved plastic region is a saddle of the membrane term (no gradient across the plane), and
-// where Eq. 12 moves the node off it depends on the metric it measures against (the reference one over-bulges,
-// the coarse face's chord metric does not bulge at all); either way every refine / coarsen cycle bent the sheet
-// a little more or less (measured: -0.7% .. -2% of a constant-curvature arc in 10 cycles). Returns the accepted
-// Gauss-Newton steps.
+// Places the node a split of edge (end0, end1) created: it starts at the middle of the embedded edge plus the
+// sagitta e^T S e / 8 of the edge e under the plastic curvature S estimated from the neighbourhood's edge offsets
+// (rest angles), on the convex side, and settles from there by Gauss-Newton on Eq. 12 in every direction. WHY
+// the start: the middle of a flat coarse face spanning a curved plastic region is a saddle of the membrane term
+// (no gradient across the plane), so Gauss-Newton from the chord never leaves it and every refine / coarsen
+// cycle flattened the sheet a little (-0.7% .. -2% of a constant-curvature arc in 10 cycles; -12% of a
+// simulator-bent strip in 100). WHY Eq. 12 decides the height rather than the estimate: holding the node at
+// the estimated sagitta fed the estimate's noise back into the plastic state (a simulator-bent strip gained
+// 39.5% rest curvature over 100 cycles; 0.8% now). Returns the accepted Gauss-Newton steps.
 int place_split_node_in_embedding(const Mesh& mesh, const std::vector<Material>& materials,
                                   PlasticEmbedding& embedding, int node, int end0, int end1);
 

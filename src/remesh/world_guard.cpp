@@ -175,24 +175,39 @@ std::vector<std::int64_t> WorldGuard::candidates(const Eigen::AlignedBox3d& box)
   return found;
 }
 
-bool WorldGuard::counts(std::int64_t entry, const int* nodes, int count, const std::vector<int>& replaced) const {
+bool WorldGuard::counts(std::int64_t entry, const std::vector<int>& replaced) const {
   const int mesh = static_cast<int>(entry >> 32), face = static_cast<int>(entry & 0xffffffff);
-  if (mesh != 0) return true;
-  if (mesh_.faces[face].dead || std::binary_search(replaced.begin(), replaced.end(), face)) return false;
-  for (int i = 0; i < 3; ++i)
-    if (std::find(nodes, nodes + count, mesh_.face_node(face, i)) != nodes + count) return false;
-  return true;
+  return mesh != 0 || (!mesh_.faces[face].dead && !std::binary_search(replaced.begin(), replaced.end(), face));
 }
 
+bool WorldGuard::touches(std::int64_t entry, const int* nodes, int count) const {
+  const int mesh = static_cast<int>(entry >> 32), face = static_cast<int>(entry & 0xffffffff);
+  if (mesh != 0) return false;
+  for (int i = 0; i < 3; ++i)
+    if (std::find(nodes, nodes + count, mesh_.face_node(face, i)) != nodes + count) return true;
+  return false;
+}
+
+// Both queries gather the candidates of all their shapes at once (one grid walk and one sort), then test each
+// candidate against the shapes whose boxes it meets.
 double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced) const {
-  double nearest = clearance_;
+  std::vector<Eigen::AlignedBox3d> boxes;
+  Eigen::AlignedBox3d all;
   for (const GuardTriangle& t : triangles) {
-    const Eigen::AlignedBox3d b = box_of(t.x, clearance_);
-    if (!b.min().allFinite() || !b.max().allFinite()) return 0;
-    for (const std::int64_t entry : candidates(b)) {
-      if (!counts(entry, t.nodes.data(), 3, replaced)) continue;
-      const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
-      if (!b.intersects(box_of(other.x, 0)) || ball_gap(t.x, other.x) >= nearest) continue;
+    boxes.push_back(box_of(t.x, clearance_));
+    if (!boxes.back().min().allFinite() || !boxes.back().max().allFinite()) return 0;
+    all.extend(boxes.back());
+  }
+  if (triangles.empty()) return clearance_;
+  double nearest = clearance_;
+  for (const std::int64_t entry : candidates(all)) {
+    if (!counts(entry, replaced)) continue;
+    const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
+    const Eigen::AlignedBox3d other_box = box_of(other.x, 0);
+    for (size_t i = 0; i < triangles.size(); ++i) {
+      const GuardTriangle& t = triangles[i];
+      if (!boxes[i].intersects(other_box) || touches(entry, t.nodes.data(), 3)) continue;
+      if (ball_gap(t.x, other.x) >= nearest) continue;
       nearest = std::min(nearest, triangle_separation(t.x, other.x));
       if (nearest <= 0) return 0;
     }
@@ -201,16 +216,24 @@ double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const
 }
 
 bool WorldGuard::sweep_is_clear(const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
+  std::vector<Eigen::AlignedBox3d> boxes;
+  Eigen::AlignedBox3d all;
   for (const GuardSweep& s : sweeps) {
     Eigen::AlignedBox3d b;
     for (const Vec3& p : s.x) b.extend(p);
     if (!b.min().allFinite() || !b.max().allFinite()) return false;
-    for (const std::int64_t entry : candidates(b)) {
-      if (!counts(entry, s.nodes.data(), 4, replaced)) continue;
-      const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
-      if (b.intersects(box_of(other.x, 0)) && ball_gap(other.x, s.x) <= 0 &&
-          triangle_meets_tetrahedron(other.x, s.x))
-        return false;
+    boxes.push_back(b);
+    all.extend(b);
+  }
+  if (sweeps.empty()) return true;
+  for (const std::int64_t entry : candidates(all)) {
+    if (!counts(entry, replaced)) continue;
+    const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
+    const Eigen::AlignedBox3d other_box = box_of(other.x, 0);
+    for (size_t i = 0; i < sweeps.size(); ++i) {
+      const GuardSweep& s = sweeps[i];
+      if (!boxes[i].intersects(other_box) || touches(entry, s.nodes.data(), 4)) continue;
+      if (ball_gap(other.x, s.x) <= 0 && triangle_meets_tetrahedron(other.x, s.x)) return false;
     }
   }
   return true;

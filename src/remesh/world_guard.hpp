@@ -73,9 +73,11 @@ class WorldGuard {
   std::vector<int> live_faces_around(int n) const;
   // Entries of the cells the box touches, plus the large faces; sorted, unique.
   std::vector<std::int64_t> candidates(const Eigen::AlignedBox3d& box) const;
-  // Whether the candidate face may be compared with a primitive on these nodes (not dead, not replaced, not
-  // touching it).
-  bool counts(std::int64_t entry, const int* nodes, int count, const std::vector<int>& replaced) const;
+  // Whether the candidate face takes part: it is another mesh's, or a live face of the edited mesh that the
+  // edit does not replace.
+  bool counts(std::int64_t entry, const std::vector<int>& replaced) const;
+  // Whether the candidate face has one of these nodes (it touches the shape, and is not compared with it).
+  bool touches(std::int64_t entry, const int* nodes, int count) const;
 
   const Mesh& mesh_;
   std::vector<const Mesh*> meshes_;  // [0] is the edited mesh

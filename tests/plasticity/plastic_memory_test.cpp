@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cylinder_fit.hpp"
 #include "plasticity/plastic_embedding.hpp"
 #include "plasticity/plastic_tensors.hpp"
 #include "remesh/remesh.hpp"
@@ -97,28 +98,9 @@ Mesh bent_strip(const Material& mat, const StripSpec& spec, double* radius) {
   return m;
 }
 
-// Curvature (1/m) of a sheet bent about one axis: its points are p(u) = c(u_x) + u_y a, so the column of the
-// least-squares affine map u -> p for u_y is the axis a; a Kasa circle fit of the points projected across a
-// gives 1 / radius. `pts[i]` belongs to material point `us[i]`.
+// Curvature (1/m) of a sheet bent about one axis (circle fit, see cylinder_fit.hpp).
 double cylinder_curvature(const std::vector<Vec3>& us, const std::vector<Vec3>& pts) {
-  const int n = static_cast<int>(pts.size());
-  Eigen::MatrixXd U(n, 3), P(n, 3);
-  for (int i = 0; i < n; ++i) {
-    U.row(i) << us[i].x(), us[i].y(), 1;
-    P.row(i) = pts[i].transpose();
-  }
-  const Eigen::MatrixXd map = U.colPivHouseholderQr().solve(P);  // 3x3: rows for u_x, u_y, 1
-  const Vec3 axis = Vec3(map.row(1).transpose()).normalized();
-  const Vec3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
-  Eigen::MatrixXd A(n, 3);
-  Eigen::VectorXd rhs(n);
-  for (int i = 0; i < n; ++i) {
-    const double x = pts[i].dot(e1), z = pts[i].dot(e2);
-    A.row(i) << 2 * x, 2 * z, 1;
-    rhs[i] = x * x + z * z;
-  }
-  const Eigen::Vector3d p = A.colPivHouseholderQr().solve(rhs);
-  return 1 / std::sqrt(p[2] + p[0] * p[0] + p[1] * p[1]);
+  return testing::fit_cylinder(us, pts).curvature();
 }
 
 struct Shape {
