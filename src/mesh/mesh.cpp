@@ -208,6 +208,14 @@ Mesh::Compaction Mesh::compact() {
   return c;
 }
 
+std::vector<int> Mesh::node_faces(int n) const {
+  std::vector<int> around;
+  for (int v : nodes[n].verts) around.insert(around.end(), verts[v].faces.begin(), verts[v].faces.end());
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  return around;
+}
+
 int Mesh::corner_of_node(int f, int node) const {
   for (int i = 0; i < 3; ++i)
     if (face_node(f, i) == node) return i;

@@ -116,6 +116,8 @@ class Mesh {
   int find_edge(int n0, int n1) const;        // kNone if absent
   int face_node(int f, int corner) const { return verts[faces[f].v[corner]].node; }
   int corner_of_node(int f, int node) const;  // kNone if absent
+  // The faces around node n (over all its verts), sorted, each once.
+  std::vector<int> node_faces(int n) const;
   int other_face(int e, int f) const { return edges[e].f[0] == f ? edges[e].f[1] : edges[e].f[0]; }
   // The node of face f opposite to edge e (kNone if f is kNone).
   int opposite_node(int e, int f) const;

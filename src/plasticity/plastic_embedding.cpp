@@ -122,13 +122,6 @@ void place_seed(const Mesh& m, PlasticEmbedding& emb, int f) {
     if (!emb.has(m.face_node(f, c))) emb.set(m.face_node(f, c), u0 + face.rest_frame * q[c]);
 }
 
-std::vector<int> node_faces(const Mesh& m, int node) {
-  std::vector<int> faces;
-  for (int v : m.nodes[node].verts)
-    for (int f : m.verts[v].faces) faces.push_back(f);
-  return sorted_unique(faces);
-}
-
 bool face_embedded(const Mesh& m, const PlasticEmbedding& emb, int f) {
   for (int c = 0; c < 3; ++c)
     if (!emb.has(m.face_node(f, c))) return false;
@@ -246,7 +239,7 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& m, const std::vector<Material>
                                       const PlasticEmbedding& emb, int node, const Vec3& y, HessianKind kind) {
   PlasticNodeEnergy out;
   auto position = [&](int n) -> Vec3 { return n == node ? y : emb.at(n); };
-  const std::vector<int> incident = node_faces(m, node);
+  const std::vector<int> incident = m.node_faces(node);
   std::vector<int> bending = incident;
   for (int f : incident) {
     const Face& face = m.faces[f];
@@ -359,7 +352,7 @@ int place_split_node_in_embedding(const Mesh& m, const std::vector<Material>& ma
   double area = 0;
   int halves = 0;
   std::vector<int> wings;
-  for (int f : node_faces(m, node)) {
+  for (int f : m.node_faces(node)) {
     if (!face_embedded(m, emb, f)) continue;
     const Face& face = m.faces[f];
     const Vec3 y0 = emb.at(m.face_node(f, 0)), y1 = emb.at(m.face_node(f, 1)), y2 = emb.at(m.face_node(f, 2));
@@ -382,7 +375,7 @@ int place_split_node_in_embedding(const Mesh& m, const std::vector<Material>& ma
   // faces alone see no hinge where they touch the sheet's boundary): sum of offset l n n^T, inner edges whole
   // and edges on the region's border half, over the region's area.
   std::vector<int> region;
-  for (int f : faces_with_flaps(m, node_faces(m, node)))
+  for (int f : faces_with_flaps(m, m.node_faces(node)))
     if (face_embedded(m, emb, f)) region.push_back(f);
   region = sorted_unique(region);
   double region_area = 0;

@@ -43,15 +43,6 @@ Vec3 rest_cross(const Mesh& m, const std::array<int, 3>& v) {
 
 Vec3 world_cross(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
 
-std::vector<int> node_faces(const Mesh& m, int n) {
-  std::vector<int> faces;
-  for (int v : m.nodes[n].verts)
-    for (int f : m.verts[v].faces) faces.push_back(f);
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  return faces;
-}
-
 std::vector<int> edges_of_faces(const Mesh& m, const std::vector<int>& faces) {
   std::vector<int> edges;
   for (int f : faces)
@@ -230,7 +221,7 @@ class Remesher {
   }
 
   bool node_inside(int n) const {
-    for (int f : node_faces(m_, n))
+    for (int f : m_.node_faces(n))
       if (!is_active(f)) return false;
     return true;
   }
@@ -363,7 +354,7 @@ class Remesher {
   bool guard_allows_collapse(int e, int gone, int keep) const {
     if (!guard_) return true;
     // The removed node slides to the kept one: each surviving face of its fan sweeps a tetrahedron.
-    const std::vector<int> fan = node_faces(m_, gone);
+    const std::vector<int> fan = m_.node_faces(gone);
     std::vector<GuardTriangle> before, after;
     std::vector<GuardSweep> sweeps;
     for (int f : fan) {
@@ -459,7 +450,7 @@ class Remesher {
     }
   }
 
-  void flip_around(int node) { flip_edges(edges_of_faces(m_, node_faces(m_, node))); }
+  void flip_around(int node) { flip_edges(edges_of_faces(m_, m_.node_faces(node))); }
 
   // --- splits -----------------------------------------------------------------------------------------------
 
@@ -618,7 +609,7 @@ class Remesher {
     if (m_.is_boundary_node(gone) && !boundary_node_on_chord(gone)) return false;
     const Vec3& x_keep = m_.nodes[keep].x;
     double gone_to_surface = kInfinity, gone_to_rest_surface = kInfinity;  // m
-    const std::vector<int> fan = node_faces(m_, gone);
+    const std::vector<int> fan = m_.node_faces(gone);
     const RestSidePositions rest(m_, o_.max_surface_change > 0 ? &materials_ : nullptr, fan);
     for (int f : fan) {
       if (f == edge.f[0] || f == edge.f[1]) continue;
@@ -694,7 +685,7 @@ class Remesher {
         continue;
       }
       PlasticEmbedding embedding;
-      const bool plastic = capture_plastic(node_faces(m_, m_.edges[e].n[side]), embedding);
+      const bool plastic = capture_plastic(m_.node_faces(m_.edges[e].n[side]), embedding);
       const EditResult r = collapse_edge(m_, e, side);
       if (!r.ok) continue;
       ++stats_.collapses;

@@ -77,18 +77,9 @@ BendingElement bending_element(const Mesh& mesh, const std::vector<Material>& ma
   return b;
 }
 
-std::vector<int> node_faces(const Mesh& mesh, int node) {
-  std::vector<int> faces;
-  for (int v : mesh.nodes[node].verts)
-    for (int f : mesh.verts[v].faces) faces.push_back(f);
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  return faces;
-}
-
 Elements gather_elements(const Mesh& mesh, const std::vector<Material>& materials, int node) {
   Elements els;
-  const std::vector<int> incident = node_faces(mesh, node);
+  const std::vector<int> incident = mesh.node_faces(node);
   std::vector<int> bending_faces = incident;
   for (int f : incident) {
     const Face& face = mesh.faces[f];
@@ -194,7 +185,7 @@ ReprojectionResult reproject_node(Mesh& mesh, const std::vector<Material>& mater
   // max_displacement; motion within the sheet cannot carry it through a nearby layer and stays free (it is
   // what removes the in-plane stress a split or collapse leaves).
   Vec3 normal = Vec3::Zero();
-  for (int f : node_faces(mesh, node)) normal += mesh.world_normal(f);
+  for (int f : mesh.node_faces(node)) normal += mesh.world_normal(f);
   if (normal.norm() > 0) normal.normalize();
   auto within_reach = [&](const Vec3& p) -> Vec3 {
     const Vec3 d = p - start;

@@ -131,29 +131,18 @@ void WorldGuard::update_face(int f) {
 }
 
 void WorldGuard::update_node(int n) {
-  for (int v : mesh_.nodes[n].verts)
-    for (int f : mesh_.verts[v].faces) update_face(f);
-}
-
-std::vector<int> WorldGuard::live_faces_around(int n) const {
-  std::vector<int> faces;
-  for (int v : mesh_.nodes[n].verts)
-    for (int f : mesh_.verts[v].faces)
-      if (!mesh_.faces[f].dead) faces.push_back(f);
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  return faces;
+  for (int f : mesh_.node_faces(n)) update_face(f);
 }
 
 std::vector<GuardTriangle> WorldGuard::fan(int n) const {
   std::vector<GuardTriangle> triangles;
-  for (int f : live_faces_around(n)) triangles.push_back(triangle(0, f));
+  for (int f : mesh_.node_faces(n)) triangles.push_back(triangle(0, f));
   return triangles;
 }
 
 std::vector<GuardSweep> WorldGuard::fan_sweep(int n, const Vec3& from) const {
   std::vector<GuardSweep> sweeps;
-  for (int f : live_faces_around(n)) {
+  for (int f : mesh_.node_faces(n)) {
     const int c = mesh_.corner_of_node(f, n);
     const int b0 = mesh_.face_node(f, (c + 1) % 3), b1 = mesh_.face_node(f, (c + 2) % 3);
     sweeps.push_back({{from, mesh_.nodes[n].x, mesh_.nodes[b0].x, mesh_.nodes[b1].x}, {n, n, b0, b1}});

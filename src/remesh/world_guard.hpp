@@ -70,7 +70,6 @@ class WorldGuard {
   std::array<int, 3> cell_of(const Vec3& p) const;
   void insert(int mesh, int face);
   GuardTriangle triangle(int mesh, int face) const;
-  std::vector<int> live_faces_around(int n) const;
   // Entries of the cells the box touches, plus the large faces; sorted, unique.
   std::vector<std::int64_t> candidates(const Eigen::AlignedBox3d& box) const;
   // Whether the candidate face takes part: it is another mesh's, or a live face of the edited mesh that the
