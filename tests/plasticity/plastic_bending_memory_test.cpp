@@ -30,6 +30,7 @@
 #include "sim/simulation.hpp"
 #include "support/files.hpp"
 #include "support/mesh_factory.hpp"
+#include "plastic_fixtures.hpp"
 
 namespace arcsim {
 namespace {
@@ -43,13 +44,7 @@ constexpr double kBendTime = 1.0, kReleaseTime = 1.1, kFadeTime = 0.05, kEndTime
 constexpr double kFine = 0.01, kCoarse = 0.03;  // m, the two uniform sizes of a remesh cycle
 
 Material thin_aluminium() {
-  Material m;
-  m.name = "aluminium strip";
-  m.thickness = 1e-3;
-  m.density = 2700;
-  m.youngs_modulus = 70e9;
-  m.poisson_ratio = 0.33;
-  m.yield_curv = kYieldCurvature;
+  Material m = testing::aluminium_sheet(kYieldCurvature, 1e-3, "aluminium strip");
   m.damping = 1e-2;  // s: settles the springback within the second after the release
   return m;
 }

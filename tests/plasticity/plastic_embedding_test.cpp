@@ -11,6 +11,7 @@
 #include "plasticity/plastic_embedding.hpp"
 #include "plasticity/plastic_tensors.hpp"
 #include "support/mesh_factory.hpp"
+#include "plastic_fixtures.hpp"
 
 namespace arcsim {
 namespace {
@@ -18,13 +19,7 @@ namespace {
 using testing::make_grid;
 
 Material aluminium() {
-  Material m;
-  m.name = "aluminium";
-  m.thickness = 1e-3;
-  m.density = 2700;
-  m.youngs_modulus = 70e9;
-  m.poisson_ratio = 0.33;
-  m.yield_curv = 10;
+  Material m = testing::aluminium_sheet(10);
   m.yield_stress = 1e8;  // stretching plasticity too: its Fp is what these tests follow
   m.flow_rate = 1e-7;
   return m;

@@ -21,6 +21,7 @@
 #include "plasticity/plastic_tensors.hpp"
 #include "remesh/remesh.hpp"
 #include "support/mesh_factory.hpp"
+#include "plastic_fixtures.hpp"
 
 namespace arcsim {
 namespace {
@@ -29,16 +30,7 @@ constexpr double kLength = 1.0, kWidth = 0.2;  // m
 constexpr double kCurvature = 0.9;              // 1/m of plastic curvature: 0.9 rad over the strip
 constexpr double kFine = 0.05, kCoarse = 0.15;  // m, the two uniform sizes of a cycle
 
-Material aluminium() {
-  Material m;
-  m.name = "aluminium";
-  m.thickness = 1e-3;
-  m.density = 2700;
-  m.youngs_modulus = 70e9;
-  m.poisson_ratio = 0.33;
-  m.yield_curv = 10;
-  return m;
-}
+Material aluminium() { return testing::aluminium_sheet(10); }
 
 // The strip's plastic state: folds of `fold` (rad) along every interior grid line x = k L / segments, set
 // either as a uniform Sp = (fold / segment) e_x e_x on every face (the constant-curvature arc: on this grid its
