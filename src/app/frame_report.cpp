@@ -57,6 +57,7 @@ std::string frame_log_line(const FrameReport& r) {
         .integer("iterations", z.iterations)
         .integer("largest_zone", z.largest_zone)
         .integer("fallback_zones", z.fallback_zones)
+        .integer("ill_conditioned_zones", z.ill_conditioned_zones)
         .integer("unresolved_steps", z.unresolved_steps);
     line.object("impact_zones", zones);
   }

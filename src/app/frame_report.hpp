@@ -42,7 +42,7 @@ struct FrameReport {
 // "meshes":{"cloth0":{"faces":..,"edge_min":..,"edge_median":..,"edge_max":..[,"splits":..,"flips":..,
 // "collapses":..,"guarded":..]},...} (m) when meshes is not empty (the edit counts when remeshed),
 // then "impact_zones":{"steps":..,"impacts":..,"zones":..,"iterations":..,"largest_zone":..,"fallback_zones":..,
-// "unresolved_steps":..} when has_impact_zones.
+// "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones.
 std::string frame_log_line(const FrameReport& report);
 
 // {"frame":..,"total":..,"time":..,"faces":..,"nodes":..,"wall":..}; total is null when the run is unbounded,

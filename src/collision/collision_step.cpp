@@ -25,6 +25,7 @@ void ImpactZoneTotals::add(const ImpactZoneStats& s) {
   iterations += s.iterations;
   largest_zone = std::max(largest_zone, s.largest_zone);
   fallback_zones += s.fallback_zones;
+  ill_conditioned_zones += s.ill_conditioned_zones;
   unresolved_steps += !s.resolved;
 }
 

@@ -33,6 +33,7 @@ struct ImpactZoneTotals {
   long long iterations = 0;  // detection rounds
   int largest_zone = 0;      // nodes, largest over the steps
   int fallback_zones = 0;    // zones moved rigidly or held at their start positions
+  int ill_conditioned_zones = 0;  // of those, zones whose projection was refused as ill-conditioned
   int unresolved_steps = 0;  // steps whose motion could not be made collision free
   void add(const ImpactZoneStats& s);
 };

@@ -241,10 +241,29 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       dirty.push_back(&z);
       zone_nodes += z.nodes.size();
     }
+    // An ill-conditioned projection (zone_solver.hpp) is not applied: the zone moves rigidly from then on,
+    // and the fallback rounds below hold it at x0 if that collides too.
+    std::vector<double> ill_ratio(dirty.size(), 0.0);
 #pragma omp parallel for schedule(dynamic, 1) if (dirty.size() > 1 && zone_nodes > 64)
     for (int k = 0; k < static_cast<int>(dirty.size()); ++k) {
-      project_zone(*dirty[k], target, g, params);
-      dirty[k]->dirty = false;
+      Zone& z = *dirty[k];
+      if (z.state == ZoneState::kProjected) {
+        const ZoneResult r = project_zone(z, target, g, params);
+        if (r.ill_conditioned) {
+          z.state = ZoneState::kRigid;
+          ill_ratio[k] = r.move_ratio;
+        }
+      }
+      if (z.state != ZoneState::kProjected) move_rigidly(z, target, g);
+      z.dirty = false;
+    }
+    for (size_t k = 0; k < dirty.size(); ++k) {
+      if (ill_ratio[k] == 0) continue;
+      ++stats.ill_conditioned_zones;
+      std::ostringstream what;
+      what << "impact zone of " << dirty[k]->nodes.size() << " nodes is ill-conditioned (meeting its constraints "
+           << "would move a node " << ill_ratio[k] << "x farther than its deepest violation); moving it rigidly";
+      warn(params, what.str());
     }
     mark_moved(dirty);
   }

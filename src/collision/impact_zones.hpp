@@ -50,6 +50,7 @@ struct ImpactZoneStats {
   int zones = 0;             // zones at the end
   int largest_zone = 0;      // nodes
   int fallback_zones = 0;    // zones moved rigidly or held at x0
+  int ill_conditioned_zones = 0;  // projections refused as ill-conditioned (those zones also count as fallback)
   bool resolved = true;      // the final motion is collision free
 };
 

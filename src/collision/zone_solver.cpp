@@ -135,6 +135,19 @@ double constraint_gap(const ZoneConstraint& c, const std::vector<Vec3>& x) {
 
 }  // namespace
 
+double required_move(const ZoneProblem& problem) {
+  double depth = problem.thickness;
+  for (const ZoneConstraint& c : problem.constraints)
+    depth = std::max(depth, problem.thickness - constraint_gap(c, problem.target));
+  return depth;
+}
+
+double largest_move(const ZoneProblem& problem, const std::vector<Vec3>& x) {
+  double moved = 0;
+  for (size_t i = 0; i < x.size(); ++i) moved = std::max(moved, (x[i] - problem.target[i]).norm());
+  return moved;
+}
+
 double worst_zone_gap(const ZoneProblem& problem, const std::vector<Vec3>& x) {
   double worst = kInfinity;
   for (const ZoneConstraint& c : problem.constraints) worst = std::min(worst, constraint_gap(c, x));
@@ -206,9 +219,13 @@ ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, Z
     finite = finite && solution[i].allFinite();
   }
   result.evaluations = zone.evaluations;
-  if (finite) x = solution;
+  if (finite) {
+    result.move_ratio = largest_move(problem, solution) / required_move(problem);
+    result.ill_conditioned = !(result.move_ratio <= kMaxZoneMoveRatio);
+    if (!result.ill_conditioned) x = solution;
+  }
   result.worst_gap = worst_zone_gap(problem, x);
-  result.solved = finite && result.worst_gap >= 0.5 * h;
+  result.solved = finite && !result.ill_conditioned && result.worst_gap >= 0.5 * h;
   return result;
 }
 

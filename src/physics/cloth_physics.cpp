@@ -184,6 +184,17 @@ double internal_energy(const Mesh& mesh, const ElementCache& cache) {
   return energy;
 }
 
+double mechanical_energy(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads) {
+  double energy = internal_energy(mesh, cache);
+  for (const Node& n : mesh.nodes) {
+    if (n.dead) continue;
+    energy += 0.5 * n.mass * n.v.squaredNorm() - n.mass * loads.gravity.dot(n.x);
+  }
+  for (const HandleSpring& s : loads.springs)
+    energy += 0.5 * s.stiffness * (mesh.nodes[s.node].x - s.target).squaredNorm();
+  return energy;
+}
+
 VecX internal_forces(const Mesh& mesh, const ElementCache& cache) {
   VecX f = VecX::Zero(3 * mesh.nodes.size());
   for (const auto& el : cache.faces) {

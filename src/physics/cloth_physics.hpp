@@ -103,6 +103,11 @@ struct ExternalLoads {
   std::vector<ContactTerm> contacts;  // their pairs must be in the pattern (update_contact_pattern)
 };
 
+// Mechanical energy (J) of the cloth: kinetic, elastic (internal_energy), the handle springs' and the gravity
+// potential (zero at the origin). Air drag and contact terms are not potentials and are left out. For energy
+// audits (Simulation::audit_energy); implicit Euler never raises it without external work.
+double mechanical_energy(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads);
+
 struct StepTiming {
   double assembly = 0, factorization = 0, solve = 0;  // wall seconds
 };

@@ -269,6 +269,7 @@ void Simulation::advance_step() {
 
   // Proximity forces enter the implicit solve; the impact-zone response follows the position update.
   refresh_elements();
+  audit(&StepEnergies::start);
   auto t0 = std::chrono::steady_clock::now();
   std::vector<std::vector<ContactTerm>> contacts;
   if (scene_.enabled("proximity") && scene_.enabled("physics")) contacts = proximity_step(dt);
@@ -283,21 +284,40 @@ void Simulation::advance_step() {
   }
   times.physics += seconds_since(t0);
   check_state();
+  audit(&StepEnergies::after_physics);
 
   t0 = std::chrono::steady_clock::now();
   if (scene_.enabled("collision")) collision_step(dt);
   times.collision += seconds_since(t0);
   check_state();
+  audit(&StepEnergies::after_collision);
 
   t0 = std::chrono::steady_clock::now();
   plasticity_step(dt);
   times.plasticity += seconds_since(t0);
+  audit(&StepEnergies::after_plasticity, true);
 
   if (step_ % frame_steps_ == 0) {
     t0 = std::chrono::steady_clock::now();
     remeshing_step();
     times.remeshing += seconds_since(t0);
     ++frame_;
+  }
+}
+
+void Simulation::audit(double StepEnergies::*phase, bool fresh_elements) {
+  if (!audit_energy) return;
+  step_energies.resize(cloths.size());
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    const Cloth& cloth = cloths[c];
+    const ExternalLoads loads = loads_for(static_cast<int>(c), time_);
+    if (fresh_elements && cloth.elements_dirty) {
+      ElementCache rebuilt;
+      build_element_cache(cloth.mesh, cloth.materials, rebuilt);
+      step_energies[c].*phase = mechanical_energy(cloth.mesh, rebuilt, loads);
+    } else {
+      step_energies[c].*phase = mechanical_energy(cloth.mesh, cloth.elements, loads);
+    }
   }
 }
 

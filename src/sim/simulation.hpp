@@ -48,6 +48,15 @@ struct Handle {
   double strength(double t) const;
 };
 
+// A cloth's mechanical energy (J, physics/cloth_physics.hpp's mechanical_energy) at the phase boundaries of the
+// last step, when Simulation::audit_energy is on. The differences are the work of each phase:
+// after_physics - start is what the implicit solve added (contact penalties, air; minus damping),
+// after_collision - after_physics what the collision response did, after_collision - after_plasticity the
+// elastic energy the flow rules released (at least the reported plastic work: weakening releases some too).
+struct StepEnergies {
+  double start = 0, after_physics = 0, after_collision = 0, after_plasticity = 0;
+};
+
 // Wall-clock seconds spent per module since the counters were last cleared.
 struct ModuleTimes {
   double physics = 0, collision = 0, remeshing = 0, plasticity = 0, fracture = 0;
@@ -95,6 +104,10 @@ class Simulation {
   // Per cloth, the operation counts of the last frame-end remeshing pass (active_faces left empty). Mesh sizes
   // for the log: remesh/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
   std::vector<RemeshStats> remesh_stats;
+  // Energy audit, off by default (tests, diagnostics): fills step_energies (per cloth) in every step, at the
+  // cost of one extra element build per cloth and plastic step. The step itself is unchanged by it.
+  bool audit_energy = false;
+  std::vector<StepEnergies> step_energies;
 
   // After topology edits of cloth c: drops the dead elements and remaps the handles' node indices.
   void compact_cloth(int c);
@@ -124,6 +137,9 @@ class Simulation {
   // Frame-end remeshing of every cloth (module "remeshing", unless the mesh is fixed), then compaction.
   void remeshing_step();
   void check_state() const;
+  // With audit_energy: records every cloth's mechanical energy into the field `phase` of step_energies; the
+  // energy after plasticity is measured with a fresh element cache (the flow rules changed the rest state).
+  void audit(double StepEnergies::*phase, bool fresh_elements = false);
 
   Scene scene_;
   std::vector<Motion> motions_;

@@ -390,5 +390,47 @@ TEST(Ccd, RotatingFaceSweepsOverVertex) {
   EXPECT_NEAR(hit->time, first, 1e-4);
 }
 
+// A node dropping onto the apex of a fan of faces (an obstacle vertex: the sheet's centre node meeting the
+// sphere's lowest vertex in conf/metal-crumple-remesh.json), slightly off-centre: every pair around the apex,
+// vertex-face and edge-edge, must give a normal that the start positions satisfy (n . sum w x0 > 0). Gap
+// directions at contact, taken at slightly different times around the apex, pointed every way and gave
+// impact zones with contradicting constraints.
+TEST(Ccd, PairsAroundAnApexAgreeWithTheStartSide) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> offset(-1e-7, 1e-7);
+  const int sides = 6;
+  const Vec3 apex(0, 0, 0);
+  std::vector<Vec3> rim;
+  for (int k = 0; k < sides; ++k) {
+    const double a = 2 * M_PI * k / sides;
+    rim.push_back(Vec3(std::cos(a), std::sin(a), 0.15));  // a shallow cone with its apex lowest
+  }
+  int impacts = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    // The moving node: from 1e-3 below the apex to 1e-4 above it (through), off-axis by ~1e-7.
+    const Vec3 p0(offset(rng), offset(rng), -1e-3), p1(p0.x() + offset(rng), p0.y() + offset(rng), 1e-4);
+    // A second node of the sheet, to make edges through the moving node.
+    const Vec3 q(0.3, 0.1, -1e-3);
+    for (int k = 0; k < sides; ++k) {
+      const Vec3 &b = rim[k], &c = rim[(k + 1) % sides];
+      const Quad vf0{p0, apex, b, c}, vf1{p1, apex, b, c};
+      if (const auto hit = vertex_face_impact(vf0, vf1)) {
+        ++impacts;
+        const Vec3 start_gap = hit->contact.weights[0] * p0 + hit->contact.weights[1] * apex +
+                               hit->contact.weights[2] * b + hit->contact.weights[3] * c;
+        EXPECT_GT(hit->contact.normal.dot(start_gap), 0) << "trial " << trial << ", face " << k;
+      }
+      const Quad ee0{q, p0, apex, b}, ee1{q, p1, apex, b};
+      if (const auto hit = edge_edge_impact(ee0, ee1)) {
+        ++impacts;
+        const Vec3 start_gap = hit->contact.weights[0] * q + hit->contact.weights[1] * p0 +
+                               hit->contact.weights[2] * apex + hit->contact.weights[3] * b;
+        EXPECT_GT(hit->contact.normal.dot(start_gap), 0) << "trial " << trial << ", edge " << k;
+      }
+    }
+  }
+  EXPECT_GT(impacts, 100);
+}
+
 }  // namespace
 }  // namespace arcsim

@@ -159,5 +159,32 @@ TEST(ZoneSolver, InfeasibleZoneReportsFailure) {
   EXPECT_TRUE(x[0].allFinite());
 }
 
+TEST(ZoneSolver, ContradictingConstraintsAreIllConditionedAndNotApplied) {
+  // One node held by two nearly opposite planes through the origin (normals +x and -x, tilted 1% up): both
+  // hold only ~100 thicknesses up, so the exact answer moves the node ~100x the deepest violation (the
+  // thickness). The solver must flag it and leave x at its start.
+  ZoneProblem p;
+  p.thickness = kGap;
+  p.target = {Vec3(0, 0, 0), Vec3(0.01, 0, 0)};
+  p.mass = {1, 1};
+  const Vec3 plus = Vec3(1, 0, 0.01).normalized(), minus = Vec3(-1, 0, 0.01).normalized();
+  p.constraints.push_back(make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, plus));
+  p.constraints.push_back(make_constraint({0, kNone, kNone, kNone}, {1, 0, 0, 0}, minus));
+  std::vector<Vec3> x = p.target;
+  const ZoneResult r = solve_impact_zone(p, x);
+  EXPECT_TRUE(r.ill_conditioned);
+  EXPECT_FALSE(r.solved);
+  EXPECT_GT(r.move_ratio, kMaxZoneMoveRatio);
+  EXPECT_EQ(max_difference(x, p.target), 0.0);
+  // The same node against one of the planes only: an ordinary, well-conditioned projection.
+  p.constraints.pop_back();
+  x = p.target;
+  const ZoneResult one = solve_impact_zone(p, x);
+  EXPECT_FALSE(one.ill_conditioned);
+  EXPECT_TRUE(one.solved);
+  EXPECT_LT(one.move_ratio, 1.01);
+  EXPECT_NEAR(largest_move(p, x), kGap, 1e-3 * kGap);
+}
+
 }  // namespace
 }  // namespace arcsim
