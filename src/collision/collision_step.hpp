@@ -25,8 +25,10 @@ struct CollisionSettings {
   int step = 0;                        // for messages
 };
 
-// Impact-zone work summed over the steps since the totals were last cleared (for the run's log).
+// Impact-zone work summed over the steps since the totals were last cleared (for the run's log), and the
+// proximity contacts of the same steps (what each collision phase did, for tests that check a phase ran).
 struct ImpactZoneTotals {
+  long long proximities = 0; // proximity (repulsion + friction) contacts found before the velocity solves
   int steps = 0;             // steps with a collision response
   long long impacts = 0;     // impacts found in the steps' first detection rounds
   long long zones = 0;       // zones at the ends of the steps

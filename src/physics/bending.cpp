@@ -56,12 +56,6 @@ Vec12T<T> theta_gradient(const Vec3T<T>& x0, const Vec3T<T>& x1, const Vec3T<T>&
 
 }  // namespace
 
-double hinge_weight(double kb, double l_rest, double A0, double A1) {
-  const double area = A0 + A1;
-  if (!(area > 0)) return 0;
-  return kb * l_rest * l_rest / (2 * area);
-}
-
 double wrap_angle(double angle) {
   const double wrapped = std::remainder(angle, 2 * M_PI);  // in [-pi, pi]
   return wrapped <= -M_PI ? wrapped + 2 * M_PI : wrapped;
@@ -82,43 +76,6 @@ Mat12 dihedral_angle_hessian(const Vec3& x0, const Vec3& x1, const Vec3& x2, con
   for (int r = 0; r < 12; ++r) H.row(r) = g(r).derivatives().transpose();
   // Exact up to round-off; symmetrise so that solvers see a symmetric matrix.
   return 0.5 * (H + H.transpose());
-}
-
-HingeTerms hinge_terms(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double theta_bar,
-                       double weight, HessianKind hessian) {
-  HingeTerms out;
-  out.theta = dihedral_angle(x0, x1, x2, x3);
-  const double delta = wrap_angle(out.theta - theta_bar);
-  out.energy = weight * delta * delta;
-  const Vec12 grad_theta = dihedral_angle_gradient(x0, x1, x2, x3);
-  out.gradient = (2 * weight * delta) * grad_theta;
-  if (hessian == HessianKind::kNone) return out;
-  out.hessian = (2 * weight) * grad_theta * grad_theta.transpose();
-  if (hessian == HessianKind::kExact)
-    out.hessian += (2 * weight * delta) * dihedral_angle_hessian(x0, x1, x2, x3);
-  return out;
-}
-
-double hinge_energy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double theta_bar,
-                    double weight) {
-  const double delta = wrap_angle(dihedral_angle(x0, x1, x2, x3) - theta_bar);
-  return weight * delta * delta;
-}
-
-Vec12 hinge_gradient(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double theta_bar,
-                     double weight) {
-  return hinge_terms(x0, x1, x2, x3, theta_bar, weight, HessianKind::kNone).gradient;
-}
-
-Mat12 hinge_hessian(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double theta_bar,
-                    double weight) {
-  return hinge_terms(x0, x1, x2, x3, theta_bar, weight, HessianKind::kExact).hessian;
-}
-
-Mat12 hinge_hessian_gauss_newton(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3,
-                                 double weight) {
-  const Vec12 grad_theta = dihedral_angle_gradient(x0, x1, x2, x3);
-  return (2 * weight) * grad_theta * grad_theta.transpose();
 }
 
 }  // namespace arcsim

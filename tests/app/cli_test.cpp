@@ -49,7 +49,6 @@ TEST(CommandLine, VersionComesFromVersionHeader) {
   const RunResult r = run_arcsim({"--version"});
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.out, std::string("arcsim ") + kVersion + "\n");
-  EXPECT_EQ(std::string(kVersion), "0.1.0");
   EXPECT_EQ(r.err, "");
 }
 

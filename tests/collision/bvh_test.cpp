@@ -80,19 +80,34 @@ TEST(Bvh, RefitFollowsMovedBoxes) {
   EXPECT_EQ(sorted(bvh.self_overlaps()), brute_self(boxes));
 }
 
-TEST(Bvh, PairsDoNotDependOnThreadCount) {
+TEST(Bvh, PairsAndTheirOrderDoNotDependOnThreadCount) {
 #ifdef _OPENMP
-  const auto boxes = random_boxes(2000, 12, 0.06);
-  Bvh bvh;
+  // 3000 boxes: 5999 tree nodes, counted twice in a self traversal, above bvh.cpp's kParallelNodes (8192), so
+  // that with several threads the traversal is split into items shared among them.
+  const auto boxes = random_boxes(3000, 12, 0.05), other = random_boxes(2500, 13, 0.05);
+  Bvh bvh, tree;
   bvh.build(boxes);
+  tree.build(other);
+  ASSERT_GE(2 * (2 * boxes.size() - 1), 8192u);
+  ASSERT_GE(2 * boxes.size() - 1 + 2 * other.size() - 1, 8192u);
   const int saved = omp_get_max_threads();
+  const int saved_dynamic = omp_get_dynamic();
+  omp_set_dynamic(0);
   omp_set_num_threads(1);
-  const auto one = bvh.self_overlaps();
-  omp_set_num_threads(4);
-  const auto four = bvh.self_overlaps();
+  const auto self_one = bvh.self_overlaps();
+  const auto cross_one = bvh.overlaps(tree);
+  for (int threads : {2, 3, 4}) {
+    omp_set_num_threads(threads);
+    // The same pairs in the same order, unsorted: callers may consume them in order.
+    EXPECT_EQ(bvh.self_overlaps(), self_one) << threads << " threads";
+    EXPECT_EQ(bvh.overlaps(tree), cross_one) << threads << " threads";
+  }
   omp_set_num_threads(saved);
-  EXPECT_EQ(sorted(one), sorted(four));
-  EXPECT_GT(one.size(), 100u);
+  omp_set_dynamic(saved_dynamic);
+  EXPECT_GT(self_one.size(), 300u);
+  EXPECT_GT(cross_one.size(), 300u);
+  // And they are the right pairs.
+  EXPECT_EQ(sorted(self_one), brute_self(boxes));
 #else
   GTEST_SKIP() << "built without OpenMP";
 #endif

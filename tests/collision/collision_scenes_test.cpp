@@ -216,21 +216,27 @@ Simulation floor_scene(const std::set<std::string>& disabled) {
 
 TEST(CollisionScenesSlow, DisabledModulesAreSkipped) {
   ASSERT_FALSE(project_meshes().empty()) << "meshes/square.obj not found";
-  // Both off: the sheet falls through the floor and no collision time is spent.
+  // Both off: the sheet falls through the floor and neither phase runs.
   Simulation none = floor_scene({"proximity", "collision"});
   const RunReport r = run(none, 1000);
   EXPECT_LT(r.lowest, -0.05);  // 2 cm above at 2 m/s: 13 cm below after 0.08 s
-  EXPECT_LT(none.times.collision, 1e-3);
-  // Impact zones alone (no repulsion forces) still keep it above the floor.
+  EXPECT_EQ(none.collision_totals().proximities, 0);
+  EXPECT_EQ(none.collision_totals().steps, 0);
+  // Impact zones alone (no repulsion forces) still keep it above the floor: they resolved impacts, and no
+  // proximity contact was made.
   Simulation ccd_only = floor_scene({"proximity"});
   const RunReport c = run(ccd_only, 10);
   EXPECT_GT(c.lowest, -1e-4);
   EXPECT_EQ(c.intersecting, 0);
-  EXPECT_GT(ccd_only.times.collision, 0);
+  EXPECT_GT(ccd_only.collision_totals().impacts, 0);
+  EXPECT_GT(ccd_only.collision_totals().zones, 0);
+  EXPECT_EQ(ccd_only.collision_totals().proximities, 0);
   // Repulsion alone: at 4 mm per step the sheet crosses the 1 mm repulsion layer within one step, so without
-  // the impact zones it ends up under the floor.
+  // the impact zones it ends up under the floor (the repulsion acted, but too late).
   Simulation repulsion_only = floor_scene({"collision"});
   EXPECT_LT(run(repulsion_only, 1000).lowest, -1e-3);
+  EXPECT_GT(repulsion_only.collision_totals().proximities, 0);
+  EXPECT_EQ(repulsion_only.collision_totals().steps, 0);
 }
 
 // A 3 x 3 sheet (20 cm) over a two-triangle floor with the floor proxy, thrown down at 2 m/s from 1 cm.
@@ -253,7 +259,12 @@ TEST(CollisionScenes, SmallSheetStopsOnFloor) {
   const RunReport r = run(sim, 5);
   EXPECT_GT(r.lowest, -1e-4);
   EXPECT_EQ(r.intersecting, 0);
-  EXPECT_GT(sim.times.collision, 0);
+  // Both phases acted: impacts were resolved in zones, and proximity contacts held the sheet afterwards.
+  const ImpactZoneTotals& totals = sim.collision_totals();
+  EXPECT_GT(totals.impacts, 0);
+  EXPECT_GT(totals.zones, 0);
+  EXPECT_GT(totals.proximities, 0);
+  EXPECT_EQ(totals.unresolved_steps, 0);
   // Without the impact zones it tunnels through (4 mm per step against a 1 mm repulsion layer).
   Scene off = small_floor_scene(dir);
   off.disabled.insert("collision");
@@ -261,7 +272,7 @@ TEST(CollisionScenes, SmallSheetStopsOnFloor) {
   EXPECT_LT(run(through, 1000).lowest, -1e-3);
 }
 
-TEST(CollisionScenes, ModulesOffCostNoCollisionTime) {
+TEST(CollisionScenes, ModulesOffDoNoCollisionWork) {
   TempDir dir;
   Scene scene = small_floor_scene(dir);
   scene.disabled.insert("collision");
@@ -269,7 +280,9 @@ TEST(CollisionScenes, ModulesOffCostNoCollisionTime) {
   Simulation sim(scene);
   const RunReport r = run(sim, 1000);
   EXPECT_LT(r.lowest, -0.05);
-  EXPECT_LT(sim.times.collision, 1e-3);
+  // Neither phase ran: no collision response in any step, no proximity contact.
+  EXPECT_EQ(sim.collision_totals().steps, 0);
+  EXPECT_EQ(sim.collision_totals().proximities, 0);
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 // built on purpose and must be reported, naming the element.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <functional>
 
 #include "io/errors.hpp"
@@ -142,8 +141,9 @@ TEST(ValidateTriangles, ReportsProblemsInDocumentedOrder) {
   EXPECT_NE(error_of(in).find("sheet.obj:13: face 4: vertex index 10 out of range"), std::string::npos);
 }
 
-TEST(ValidateTriangles, LargeMeshIsFast) {
-  // 80k triangles; a quadratic check would take minutes.
+TEST(ValidateTriangles, LargeMeshIsCheckedThroughout) {
+  // 80k triangles: a problem near the end of a large input is found. (Speed, linear in the size, is measured
+  // by BM_ValidateTriangles in tools/bench/mesh_bench.cpp, not asserted here.)
   const int n = 200;
   TriangleInput in;
   in.node_count = (n + 1) * (n + 1);
@@ -153,12 +153,9 @@ TEST(ValidateTriangles, LargeMeshIsFast) {
       in.vert_node.push_back(grid_node(n, i, j));
     }
   in.tris = test::grid_triangles(n, n, [&](int i, int j) { return grid_node(n, i, j); });
-  const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(error_of(in), "");
   in.tris.push_back(in.tris[1000]);
   EXPECT_NE(error_of(in).find("duplicates face 1001"), std::string::npos);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 20.0);
 }
 
 // ------------------------------------------------------------------------------------------------------------
@@ -371,15 +368,13 @@ TEST(CheckMesh, IgnoresTombstonesButNotLinksToThem) {
   EXPECT_EQ(check_mesh(m), "");
 }
 
-TEST(CheckMesh, LargeMeshIsFast) {
-  // 45k faces: a check after each topology phase must stay cheap.
+TEST(CheckMesh, LargeMeshIsCheckedThroughout) {
+  // 45k faces: a bad face near the end of a large mesh is found. (The check runs after each topology phase, so
+  // it must stay cheap: BM_CheckMesh in tools/bench/mesh_bench.cpp measures it.)
   Mesh m = make_flat_grid(150, 150);
-  const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(check_mesh(m), "");
   m.faces[44000].Fp(0, 0) = std::nan("");
   EXPECT_CAUGHT(check_mesh(m), "face 44000");
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 20.0);
 }
 
 TEST(CountComponents, CountsPiecesJoinedByEdges) {
