@@ -256,8 +256,11 @@ void expect_healthy(const PerturbedRun& r, const std::string& what) {
 TEST(MetalCrumpleSlow, RemeshedSheetHoldsUnderRoundingPerturbations) {
   const fs::path conf = project_conf();
   ASSERT_FALSE(conf.empty()) << "conf/metal-crumple.json not found";
-  // Seeds 2-5 broke before the fix (1.1e11, 4.1e4, 4.5e8 and 2.0e7 J in one frame, the sheet dragged up).
-  for (unsigned seed : {2u, 3u, 4u, 5u}) {
+  // Before the fix, 5 of seeds 0-11 broke on the machine this was written on (seeds 2-5 here: 1.1e11, 4.1e4,
+  // 6.6e7 and 2.0e7 J in one frame, the sheet dragged up through the sphere); eight seeds make it all but
+  // certain that some break on any machine (collision/ccd_test.cpp's PairsAroundAnApex test fails
+  // deterministically without the fix).
+  for (unsigned seed = 1; seed <= 8; ++seed) {
     const PerturbedRun r = run_perturbed(conf / "metal-crumple-remesh.json", seed);
     print_run("metal-crumple-remesh", seed, r);
     expect_healthy(r, "metal-crumple-remesh.json, seed " + std::to_string(seed));
