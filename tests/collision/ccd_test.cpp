@@ -414,18 +414,14 @@ TEST(Ccd, PairsAroundAnApexAgreeWithTheStartSide) {
     for (int k = 0; k < sides; ++k) {
       const Vec3 &b = rim[k], &c = rim[(k + 1) % sides];
       const Quad vf0{p0, apex, b, c}, vf1{p1, apex, b, c};
-      if (const auto hit = vertex_face_impact(vf0, vf1)) {
-        ++impacts;
-        const Vec3 start_gap = hit->contact.weights[0] * p0 + hit->contact.weights[1] * apex +
-                               hit->contact.weights[2] * b + hit->contact.weights[3] * c;
-        EXPECT_GT(hit->contact.normal.dot(start_gap), 0) << "trial " << trial << ", face " << k;
-      }
       const Quad ee0{q, p0, apex, b}, ee1{q, p1, apex, b};
-      if (const auto hit = edge_edge_impact(ee0, ee1)) {
+      for (const auto& [hit, start] : {std::make_pair(vertex_face_impact(vf0, vf1), vf0),
+                                       std::make_pair(edge_edge_impact(ee0, ee1), ee0)}) {
+        if (!hit) continue;
         ++impacts;
-        const Vec3 start_gap = hit->contact.weights[0] * q + hit->contact.weights[1] * p0 +
-                               hit->contact.weights[2] * apex + hit->contact.weights[3] * b;
-        EXPECT_GT(hit->contact.normal.dot(start_gap), 0) << "trial " << trial << ", edge " << k;
+        Vec3 start_gap = Vec3::Zero();
+        for (int i = 0; i < 4; ++i) start_gap += hit->contact.weights[i] * start[i];
+        EXPECT_GT(hit->contact.normal.dot(start_gap), 0) << "trial " << trial << ", side " << k;
       }
     }
   }
