@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

@@ -6,7 +6,7 @@
 
 #include "app/command.hpp"
 #include "app/version.hpp"
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

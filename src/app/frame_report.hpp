@@ -14,7 +14,7 @@ struct FrameWallTimes {
   double total = 0;  // the whole frame: stepping and output
 };
 
-// Mesh size of one cloth at the end of a frame (remesh/remesh_cloth.hpp's mesh_size_stats).
+// Mesh size of one cloth at the end of a frame (sim/remesh_cloth.hpp's mesh_size_stats).
 struct ClothMeshReport {
   long long faces = 0;
   double edge_min = 0, edge_median = 0, edge_max = 0;  // world edge lengths (m)

@@ -8,9 +8,9 @@
 
 #include "app/output_files.hpp"
 #include "app/scene_copy.hpp"
-#include "io/errors.hpp"
 #include "io/obj.hpp"
 #include "io/state.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

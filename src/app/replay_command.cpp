@@ -10,9 +10,9 @@
 
 #include "app/arguments.hpp"
 #include "app/output_files.hpp"
-#include "io/errors.hpp"
 #include "io/obj.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 #include "render/render.hpp"
 
 namespace arcsim {

@@ -9,9 +9,9 @@
 #include "app/output_files.hpp"
 #include "app/simulate_command.hpp"
 #include "app/threads.hpp"
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
 #include "io/state.hpp"
+#include "math/errors.hpp"
 #include "sim/simulation.hpp"
 
 namespace arcsim {

@@ -14,8 +14,8 @@
 
 #include "app/json_line.hpp"
 #include "app/output_files.hpp"
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

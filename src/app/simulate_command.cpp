@@ -11,9 +11,9 @@
 #include "app/output.hpp"
 #include "app/progress.hpp"
 #include "app/threads.hpp"
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
-#include "remesh/remesh_cloth.hpp"
+#include "math/errors.hpp"
+#include "sim/remesh_cloth.hpp"
 #include "sim/simulation.hpp"
 
 namespace arcsim {

@@ -1,20 +1,5 @@
-// Error types that carry the process exit code the command line maps them to.
+// Moved to math/errors.hpp (the bottom layer). Kept for src/physics/, whose includes change with the element
+// builder's rework (issue 11, item 2); remove once nothing includes it.
 #pragma once
 
-#include <stdexcept>
-#include <string>
-
-namespace arcsim {
-
-// Bad input: scene, mesh, material, state file or arguments. One line naming the file and the key, line or
-// element at fault. Exit code 2.
-struct InputError : std::runtime_error {
-  explicit InputError(const std::string& what) : std::runtime_error(what) {}
-};
-
-// The simulation went numerically unstable (NaN, solver failure). Exit code 3.
-struct NumericalError : std::runtime_error {
-  explicit NumericalError(const std::string& what) : std::runtime_error(what) {}
-};
-
-}  // namespace arcsim
+#include "math/errors.hpp"

@@ -16,7 +16,7 @@
 #include <system_error>
 #include <unordered_set>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "mesh/validate.hpp"
 
 namespace arcsim {

@@ -14,7 +14,7 @@
 #include <set>
 #include <sstream>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

@@ -14,7 +14,7 @@
 #include <system_error>
 #include <utility>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
 

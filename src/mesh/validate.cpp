@@ -6,7 +6,7 @@
 #include <sstream>
 #include <tuple>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

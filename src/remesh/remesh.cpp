@@ -1,18 +1,14 @@
 #include "remesh/remesh.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
-#include <memory>
 #include <unordered_set>
 #include <utility>
 
 #include "collision/distance.hpp"
-#include "mesh/edits.hpp"
-#include "mesh/validate.hpp"
+#include "edit/edit_session.hpp"
 #include "plasticity/plastic_embedding.hpp"
-#include "remesh/world_guard.hpp"
 
 namespace arcsim {
 
@@ -37,36 +33,7 @@ int vert_at(const Mesh& m, int f, int n) {
   return c == kNone ? kNone : m.faces[f].v[c];
 }
 
-Vec3 rest_cross(const Mesh& m, const std::array<int, 3>& v) {
-  return (m.verts[v[1]].u - m.verts[v[0]].u).cross(m.verts[v[2]].u - m.verts[v[0]].u);
-}
-
 Vec3 world_cross(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
-
-std::vector<int> edges_of_faces(const Mesh& m, const std::vector<int>& faces) {
-  std::vector<int> edges;
-  for (int f : faces)
-    if (!m.faces[f].dead) edges.insert(edges.end(), m.faces[f].e.begin(), m.faces[f].e.end());
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  return edges;
-}
-
-// Linear part of the affine map taking a face's rest triangle to its world triangle, extended by mapping the
-// rest normal to the world normal (identity when the world triangle is degenerate).
-Mat3 rest_to_world_map(const Mesh& m, int f) {
-  const Face& face = m.faces[f];
-  const Vec3 &u0 = m.verts[face.v[0]].u, &u1 = m.verts[face.v[1]].u, &u2 = m.verts[face.v[2]].u;
-  const Vec3 &x0 = m.nodes[m.face_node(f, 0)].x, &x1 = m.nodes[m.face_node(f, 1)].x,
-             &x2 = m.nodes[m.face_node(f, 2)].x;
-  const Vec3 nu = (u1 - u0).cross(u2 - u0), nx = (x1 - x0).cross(x2 - x0);
-  if (!(nu.norm() > 0) || !(nx.norm() > 0)) return Mat3::Identity();
-  Mat3 Du, Dx;
-  Du << u1 - u0, u2 - u0, nu.normalized();
-  Dx << x1 - x0, x2 - x0, nx.normalized();
-  const Mat3 map = Dx * Du.inverse();
-  return map.allFinite() ? map : Mat3::Identity();
-}
 
 // Rest-side positions of a neighbourhood against which max_surface_change measures the world's change: the
 // nodes' rest positions u, or, where the faces (and their flaps) hold plastic state, their local plastic
@@ -169,23 +136,17 @@ bool should_flip(const Mesh& m, int e, double threshold, double max_surface_chan
 
 namespace {
 
+// The remesher is a client of the edit session (edit/edit_session.hpp): it sizes the mesh and chooses which
+// edge to split, flip or collapse, and in which order; everything an edit needs beyond that (rest positions and
+// angles, plastic transfer, reprojection, the world guard, the subset's bookkeeping) is the session's.
 class Remesher {
  public:
   Remesher(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
            const std::vector<int>* subset)
-      : m_(mesh), materials_(materials), o_(options), subset_(subset != nullptr) {
-    if (subset_) {
-      active_.assign(m_.faces.size(), 0);
-      for (int f : *subset)
-        if (f >= 0 && f < static_cast<int>(m_.faces.size()) && !m_.faces[f].dead) active_[f] = 1;
-    }
-    for (const Face& f : m_.faces)
-      if (!f.dead) ++live_faces_;
-    curved_reference_ = o_.reference != nullptr && o_.reference->kind() != "linear";
+      : m_(mesh), materials_(materials), o_(options), session_(mesh, materials, session_options(options), subset) {
     const RemeshingParams& r = o_.sizing.remeshing;
     aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
     min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
-    if (o_.world_clearance > 0) guard_ = std::make_unique<WorldGuard>(m_, o_.obstacles, o_.world_clearance);
   }
 
   RemeshStats run() {
@@ -193,13 +154,25 @@ class Remesher {
     flip_edges(active_edges());
     split_rounds();
     collapse_rounds();
-    for (size_t f = 0; f < m_.faces.size(); ++f)
-      if (!m_.faces[f].dead && is_active(static_cast<int>(f))) stats_.active_faces.push_back(static_cast<int>(f));
-    return stats_;
+    RemeshStats stats;
+    static_cast<EditCounts&>(stats) = session_.counts();
+    stats.active_faces = session_.zone_faces();
+    return stats;
   }
 
  private:
-  bool is_active(int f) const { return !subset_ || (f < static_cast<int>(active_.size()) && active_[f]); }
+  static EditSessionOptions session_options(const RemeshOptions& o) {
+    EditSessionOptions s;
+    s.reference = o.reference;
+    s.plastic_embedding = o.sizing.remeshing.plastic_embedding;
+    s.reproject = o.reproject;
+    s.reprojection = o.reprojection;
+    s.world_clearance = o.world_clearance;
+    s.obstacles = o.obstacles;
+    return s;
+  }
+
+  bool is_active(int f) const { return session_.in_zone(f); }
 
   // An edge may be split when one of its faces is active (a border edge of a subset too, so that the refined
   // region stays conforming), but flipped only when all its faces are: flips and collapses stay inside the
@@ -233,181 +206,6 @@ class Remesher {
     return edges;
   }
 
-  // Counts the faces and marks new faces active: all of them (flips and collapses act inside the subset), or,
-  // for splits, a child when its parent was (active_by_corner: each parent's corner opposite the edge).
-  void record(const EditResult& r, const std::vector<std::pair<int, bool>>* active_by_corner = nullptr) {
-    live_faces_ += static_cast<long>(r.added_faces.size()) - static_cast<long>(r.removed_faces.size());
-    if (!subset_) return;
-    if (active_.size() < m_.faces.size()) active_.resize(m_.faces.size(), 0);
-    for (int f : r.added_faces) {
-      bool active = active_by_corner == nullptr;
-      if (!active)
-        for (const auto& [node, parent_active] : *active_by_corner)
-          if (m_.corner_of_node(f, node) != kNone) active = parent_active;
-      active_[f] = active;
-    }
-  }
-
-  // --- rest angles ----------------------------------------------------------------------------------------
-
-  bool on_reference(int v) const {
-    const Vec3& u = m_.verts[v].u;
-    const double tolerance = 1e-9 * (1 + u.norm());
-    return (o_.reference->closest_point(u) - u).norm() <= tolerance;
-  }
-
-  // The reference surface's rest dihedral of an interior, non-seam edge (0 otherwise, like Mesh::rest_dihedral).
-  // A vert left off the surface (its projection was refused) makes the actual rest triangles the stress-free
-  // shape, so the geometric rest dihedral is used there.
-  double reference_dihedral(int e) const {
-    const Edge& edge = m_.edges[e];
-    if (edge.is_boundary()) return 0;
-    const int f0 = edge.f[0], f1 = edge.f[1];
-    const int a0 = vert_at(m_, f0, edge.n[0]), a1 = vert_at(m_, f0, edge.n[1]);
-    if (a0 != vert_at(m_, f1, edge.n[0]) || a1 != vert_at(m_, f1, edge.n[1])) return 0;
-    const int a2 = vert_at(m_, f0, m_.opposite_node(e, f0)), b3 = vert_at(m_, f1, m_.opposite_node(e, f1));
-    for (int v : {a0, a1, a2, b3})
-      if (!on_reference(v)) return m_.rest_dihedral(e);
-    return o_.reference->rest_dihedral(m_.verts[a0].u, m_.verts[a1].u, m_.verts[a2].u, m_.verts[b3].u);
-  }
-
-  // Plastic offsets (rest angle minus geometric rest dihedral) of the edges, as the edits left them.
-  std::vector<double> plastic_offsets(const std::vector<int>& edges) const {
-    std::vector<double> offsets;
-    for (int e : edges) offsets.push_back(m_.edges[e].rest_theta - m_.rest_dihedral(e));
-    return offsets;
-  }
-
-  // Rest angle = plastic offset + the reference's dihedral of the current rest triangles. Without a curved
-  // reference the edits' geometric rest dihedral is already the right one.
-  void apply_rest_angles(const std::vector<int>& edges, const std::vector<double>& offsets) {
-    for (size_t i = 0; i < edges.size(); ++i) {
-      const int e = edges[i];
-      if (m_.edges[e].dead) continue;
-      const double base = curved_reference_ ? reference_dihedral(e) : m_.rest_dihedral(e);
-      m_.edges[e].rest_theta = offsets[i] + base;
-    }
-  }
-
-  void refresh_rest_angles(const std::vector<int>& faces) {
-    if (!curved_reference_) return;
-    const std::vector<int> edges = edges_of_faces(m_, faces);
-    apply_rest_angles(edges, plastic_offsets(edges));
-  }
-
-  void reproject(int node) {
-    if (!o_.reproject || m_.nodes[node].preserve) return;
-    const Vec3 x = m_.nodes[node].x, x0 = m_.nodes[node].x0;
-    std::vector<GuardTriangle> before;
-    if (guard_) before = guard_->fan(node);
-    if (!reproject_node(m_, materials_, node, o_.reprojection).moved) return;
-    if (!keep_move(node, before, x, x0)) return;
-    ++stats_.reprojections;
-  }
-
-  // --- world-space guard --------------------------------------------------------------------------------------
-
-  // After `node` moved from (x, x0), where its faces were `before`: keeps the move if the guard allows it
-  // (and indexes the moved faces), else puts the node back. True if the move stays.
-  bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0) {
-    if (!guard_) return true;
-    if (m_.nodes[node].x != x && !guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), {})) {
-      m_.nodes[node].x = x;
-      m_.nodes[node].x0 = x0;
-      ++stats_.guarded;
-      return false;
-    }
-    guard_->update_node(node);
-    return true;
-  }
-
-  void index_faces(const std::vector<int>& faces) {
-    if (!guard_) return;
-    for (int f : faces) guard_->update_face(f);
-  }
-
-  GuardTriangle world_triangle(std::array<int, 3> nodes) const {
-    GuardTriangle t;
-    t.nodes = nodes;
-    for (int i = 0; i < 3; ++i) t.x[i] = m_.nodes[nodes[i]].x;
-    return t;
-  }
-
-  GuardTriangle face_triangle(int f) const {
-    return world_triangle({m_.face_node(f, 0), m_.face_node(f, 1), m_.face_node(f, 2)});
-  }
-
-  // Whether flipping interior edge e keeps the world surface clear.
-  bool guard_allows_flip(int e) const {
-    if (!guard_) return true;
-    const Edge& edge = m_.edges[e];
-    const int a = m_.opposite_node(e, edge.f[0]), b = m_.opposite_node(e, edge.f[1]);
-    const std::vector<GuardTriangle> before{face_triangle(edge.f[0]), face_triangle(edge.f[1])};
-    const std::vector<GuardTriangle> after{world_triangle({edge.n[0], a, b}), world_triangle({edge.n[1], b, a})};
-    const std::array<int, 4> quad{edge.n[0], edge.n[1], a, b};
-    GuardSweep sweep{{}, quad};
-    for (int i = 0; i < 4; ++i) sweep.x[i] = m_.nodes[quad[i]].x;
-    return guard_->allows(before, after, {sweep}, {edge.f[0], edge.f[1]});
-  }
-
-  // Whether collapsing edge e by removing node `gone` into node `keep` keeps the world surface clear.
-  bool guard_allows_collapse(int e, int gone, int keep) const {
-    if (!guard_) return true;
-    // The removed node slides to the kept one: each surviving face of its fan sweeps a tetrahedron.
-    const std::vector<int> fan = m_.node_faces(gone);
-    std::vector<GuardTriangle> before, after;
-    std::vector<GuardSweep> sweeps;
-    for (int f : fan) {
-      before.push_back(face_triangle(f));
-      if (f == m_.edges[e].f[0] || f == m_.edges[e].f[1]) continue;
-      const int c = m_.corner_of_node(f, gone);
-      const int b0 = m_.face_node(f, (c + 1) % 3), b1 = m_.face_node(f, (c + 2) % 3);
-      std::array<int, 3> nodes{m_.face_node(f, 0), m_.face_node(f, 1), m_.face_node(f, 2)};
-      nodes[c] = keep;
-      after.push_back(world_triangle(nodes));
-      sweeps.push_back({{m_.nodes[gone].x, m_.nodes[keep].x, m_.nodes[b0].x, m_.nodes[b1].x}, {gone, keep, b0, b1}});
-    }
-    return guard_->allows(before, after, sweeps, fan);
-  }
-
-  // --- plastic transfer (paper §5.2) ----------------------------------------------------------------------
-
-  // Adds the wall time since `start` to the plastic transfer's total.
-  void add_plastic_time(std::chrono::steady_clock::time_point start) {
-    stats_.plastic_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
-
-  // Before an edit of `faces`: true if they hold plastic state to transfer; with the embedding transfer, their
-  // plastic embedding is built into `embedding`.
-  bool capture_plastic(const std::vector<int>& faces, PlasticEmbedding& embedding) {
-    const auto start = std::chrono::steady_clock::now();
-    const bool plastic = capture_plastic_state(faces, embedding);
-    add_plastic_time(start);
-    return plastic;
-  }
-
-  bool capture_plastic_state(const std::vector<int>& faces, PlasticEmbedding& embedding) const {
-    std::vector<int> live;
-    for (int f : faces)
-      if (f != kNone) live.push_back(f);
-    if (!neighbourhood_has_plasticity(m_, materials_, live)) return false;
-    if (o_.sizing.remeshing.plastic_embedding) embedding = build_plastic_embedding(m_, live);
-    return true;
-  }
-
-  // After the edit (and the rest-angle update): Fp, Sp and edge rest angles of the new faces, from the
-  // embedding or, with "plastic_transfer": "interpolate", from the edit's interpolated Sp.
-  void transfer_plastic(const EditResult& r, bool plastic, const PlasticEmbedding& embedding) {
-    if (!plastic) return;
-    const auto start = std::chrono::steady_clock::now();
-    if (o_.sizing.remeshing.plastic_embedding) {
-      rebuild_plasticity_from_embedding(m_, materials_, embedding, r.added_faces);
-    } else {
-      interpolate_plasticity(m_, materials_, r.added_faces);
-    }
-    add_plastic_time(start);
-  }
-
   // --- flips ------------------------------------------------------------------------------------------------
 
   // Flips on independent sets: within a pass no two flipped edges share a face (an edge whose face was
@@ -427,20 +225,9 @@ class Remesher {
           continue;
         }
         if (!should_flip(m_, e, o_.edge_flip_threshold, o_.max_surface_change, &materials_)) continue;
-        if (!guard_allows_flip(e)) {
-          ++stats_.guarded;
-          continue;
-        }
-        PlasticEmbedding embedding;
-        const bool plastic = capture_plastic({f0, f1}, embedding);
-        const EditResult r = flip_edge(m_, e);
+        const EditResult r = session_.flip_edge(e);
         if (!r.ok) continue;
         ++done;
-        ++stats_.flips;
-        record(r);
-        index_faces(r.added_faces);
-        refresh_rest_angles(r.added_faces);
-        transfer_plastic(r, plastic, embedding);
         used.insert(r.added_faces.begin(), r.added_faces.end());
         for (int ne : edges_of_faces(m_, r.added_faces)) next.push_back(ne);
       }
@@ -470,101 +257,11 @@ class Remesher {
     return true;
   }
 
-  // Moves the new vert's rest position onto the reference along its averaged rest normal, if the faces stay
-  // valid (not degenerate, normals turned by less than 60 degrees).
-  void project_vert(int v, double max_distance) {
-    Vert& vert = m_.verts[v];
-    Vec3 normal = Vec3::Zero();
-    for (int f : vert.faces) normal += m_.faces[f].rest_area * m_.faces[f].rest_normal;
-    const Vec3 target = o_.reference->project(vert.u, normal, max_distance);
-    if (!target.allFinite() || target == vert.u) return;
-    const Vec3 old = vert.u;
-    std::vector<Vec3> old_normals;
-    for (int f : vert.faces) old_normals.push_back(rest_cross(m_, m_.faces[f].v));
-    vert.u = target;
-    for (size_t i = 0; i < vert.faces.size(); ++i) {
-      const std::array<int, 3>& fv = m_.faces[vert.faces[i]].v;
-      const Vec3 n = rest_cross(m_, fv);
-      if (rest_triangle_degenerate(m_.verts[fv[0]].u, m_.verts[fv[1]].u, m_.verts[fv[2]].u) ||
-          n.dot(old_normals[i]) <= 0.5 * n.norm() * old_normals[i].norm()) {
-        vert.u = old;
-        return;
-      }
-    }
-  }
-
   bool split(int e) {
     if (!split_children_ok(e)) return false;
-    const double rest_length = [&] {
-      double l = 0;
-      for (int s = 0; s < 2; ++s) {
-        const int f = m_.edges[e].f[s];
-        if (f == kNone) continue;
-        const Vec3& u0 = m_.verts[vert_at(m_, f, m_.edges[e].n[0])].u;
-        l = std::max(l, (m_.verts[vert_at(m_, f, m_.edges[e].n[1])].u - u0).norm());
-      }
-      return l;
-    }();
-    // Children are told apart by the parent's corner opposite the edge.
-    std::vector<std::pair<int, bool>> active_by_corner;
-    for (int s = 0; s < 2; ++s) {
-      const int f = m_.edges[e].f[s];
-      if (f != kNone) active_by_corner.emplace_back(m_.opposite_node(e, f), is_active(f));
-    }
-    const int end0 = m_.edges[e].n[0], end1 = m_.edges[e].n[1];
-    PlasticEmbedding embedding;
-    const bool plastic = capture_plastic({m_.edges[e].f[0], m_.edges[e].f[1]}, embedding);
-    const EditResult r = split_edge(m_, e, 0.5);
+    const EditResult r = session_.split_edge(e, 0.5);
     if (!r.ok) return false;
-    ++stats_.splits;
-    record(r, &active_by_corner);
-    index_faces(r.added_faces);
-    const int node = r.added_nodes[0];
-    // The midpoint lies on the old surface; the moves below (onto the curved rest shape, into the plastic
-    // embedding) are checked by the guard together.
-    const Vec3 mid_x = m_.nodes[node].x, mid_x0 = m_.nodes[node].x0;
-    std::vector<GuardTriangle> flat;
-    if (guard_) flat = guard_->fan(node);
-
-    // Initial world guess follows the rest displacement through the old faces' deformation.
-    Mat3 map = Mat3::Zero();
-    for (int f : r.added_faces) map += rest_to_world_map(m_, f) / static_cast<double>(r.added_faces.size());
-    const std::vector<int> edges = edges_of_faces(m_, r.added_faces);
-    const std::vector<double> offsets = plastic_offsets(edges);
-    if (o_.reference != nullptr && !r.added_verts.empty()) {
-      const Vec3 before = m_.verts[r.added_verts[0]].u;
-      for (int v : r.added_verts) project_vert(v, rest_length);
-      for (int f : r.added_faces) m_.update_rest_data(f);
-      apply_rest_angles(edges, offsets);
-      const Vec3 shift = map * (m_.verts[r.added_verts[0]].u - before);
-      if (shift.allFinite()) {
-        m_.nodes[node].x += shift;
-        m_.nodes[node].x0 += shift;
-      }
-    }
-    if (plastic && embedding.has(end0) && embedding.has(end1)) {
-      // Paper §5.2: the new node goes onto the plastic surface in the embedding (place_split_node_in_embedding
-      // says how); its world position follows the embedded neighbourhood's shape.
-      const auto start = std::chrono::steady_clock::now();
-      place_split_node_in_embedding(m_, materials_, embedding, node, end0, end1);
-      Vec3 shift = world_position_from_embedding(m_, embedding, node) - m_.nodes[node].x;
-      add_plastic_time(start);
-      // The node moves no farther than the reprojection may move it across the sheet (max_displacement); the
-      // reprojection that follows is free within the sheet. WHY: the world can be bent further than the plastic
-      // shape (a sheet pressed around an obstacle), and moving a new node fully onto the plastic shape carried
-      // it into the obstacle (measured on conf/metal-crumple-remesh.json: 18 cloth / sphere edge crossings after
-      // the first refining frame without reprojection; a limit on the motion along the normal alone left them).
-      const double limit = o_.reprojection.max_displacement;
-      if (shift.norm() > limit) shift *= limit / shift.norm();
-      if (shift.allFinite()) {
-        m_.nodes[node].x += shift;
-        m_.nodes[node].x0 += shift;
-      }
-    }
-    keep_move(node, flat, mid_x, mid_x0);
-    transfer_plastic(r, plastic, embedding);
-    reproject(node);
-    flip_around(node);
+    flip_around(r.added_nodes[0]);
     return true;
   }
 
@@ -582,7 +279,7 @@ class Remesher {
                 });
       int count = 0;
       for (const auto& [length, e] : long_edges) {
-        if (live_faces_ >= static_cast<long>(o_.max_faces)) return;
+        if (session_.live_faces() >= static_cast<long>(o_.max_faces)) return;
         if (!m_.edges[e].dead && split(e)) ++count;
       }
       if (count == 0) return;
@@ -680,20 +377,7 @@ class Remesher {
     for (int side = 0; side < 2; ++side) {
       if (!can_collapse(e, side)) continue;
       const int keep = m_.edges[e].n[1 - side];
-      if (!guard_allows_collapse(e, m_.edges[e].n[side], keep)) {
-        ++stats_.guarded;
-        continue;
-      }
-      PlasticEmbedding embedding;
-      const bool plastic = capture_plastic(m_.node_faces(m_.edges[e].n[side]), embedding);
-      const EditResult r = collapse_edge(m_, e, side);
-      if (!r.ok) continue;
-      ++stats_.collapses;
-      record(r);
-      index_faces(r.added_faces);
-      refresh_rest_angles(r.added_faces);
-      transfer_plastic(r, plastic, embedding);
-      reproject(keep);
+      if (!session_.collapse_edge(e, side).ok) continue;
       flip_around(keep);
       return true;
     }
@@ -718,13 +402,8 @@ class Remesher {
   Mesh& m_;
   const std::vector<Material>& materials_;
   const RemeshOptions& o_;
-  bool subset_;
-  std::vector<char> active_;
-  long live_faces_ = 0;
-  bool curved_reference_ = false;
+  EditSession session_;
   double aspect_min_ = 0, min_area_ = 0;
-  std::unique_ptr<WorldGuard> guard_;
-  RemeshStats stats_;
 };
 
 }  // namespace

@@ -7,16 +7,17 @@
 //  3. rounds of splits: every edge of metric length > 1, longest first, at its midpoint; flips around each;
 //  4. rounds of collapses: edges of metric length < 1, shortest first, either end, under ARCSim's quality
 //     rules (see can_collapse in remesh.cpp); flips around each.
-// Every rest position a split creates is projected onto the cloth's reference surface along the averaged rest
-// normal, and edges whose faces change get rest angle = plastic offset + the reference's rest dihedral, so a
-// curved rest shape stays curved. After every split and collapse the changed node's world position is
-// reprojected (remesh/reprojection.hpp, paper Eq. 13). With a world clearance, no edit or move may bring the
-// surface into another one (remesh/world_guard.hpp). Loops are bounded (rounds, flips per call, face count).
-// The mesh is left with tombstones: the caller compacts.
+// The remesher only chooses: sizing, which edge to edit and in which order. Every edit goes through an edit session
+// (edit/edit_session.hpp), which projects new rest positions onto the cloth's reference surface, sets rest angles
+// (plastic offset + the reference's rest dihedral, so a curved rest shape stays curved), carries the plastic state
+// (local plastic embedding), reprojects the changed node (paper Eq. 13) and, with a world clearance, keeps every
+// edit and move from bringing the surface into another one (remesh/world_guard.hpp). Loops are bounded (rounds,
+// flips per call, face count). The mesh is left with tombstones: the caller compacts.
 #pragma once
 
 #include <vector>
 
+#include "edit/edit_session.hpp"
 #include "mesh/mesh.hpp"
 #include "physics/material.hpp"
 #include "remesh/reprojection.hpp"
@@ -46,14 +47,10 @@ struct RemeshOptions {
   size_t max_faces = 2000000;          // no split beyond this many live faces (a safety net, not a size control)
 };
 
-struct RemeshStats {
-  int splits = 0, flips = 0, collapses = 0, reprojections = 0;
-  int guarded = 0;  // edits and node moves refused (or undone) by the world-space guard
-  // Wall time (s) of the plastic transfer inside the pass: building embeddings, placing split nodes in them and
-  // rebuilding Fp / Sp (or interpolating), for the benchmarks. Included in the pass's total time.
-  double plastic_seconds = 0;
-  // Live faces of the active region after the pass: the subset's surviving faces plus every face created
-  // (all live faces when no subset was given). Indices before compaction.
+// What a pass did: the edit session's counts (edit/edit_session.hpp; node_splits stays 0, remeshing makes none)
+// and the live faces of the active region after the pass: the subset's surviving faces plus every face created
+// (all live faces when no subset was given), indices before compaction.
+struct RemeshStats : EditCounts {
   std::vector<int> active_faces;
 };
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 

@@ -9,7 +9,7 @@
 #include <initializer_list>
 #include <stdexcept>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "render/offscreen.hpp"
 
 namespace arcsim {

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <tuple>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "mesh/mesh.hpp"
 
 namespace arcsim {

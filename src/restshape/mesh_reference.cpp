@@ -2,7 +2,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "restshape/reference_surface.hpp"
 #include "restshape/triangle_tree.hpp"
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "math/errors.hpp"
 #include "restshape/sphere_fit.hpp"
 
 namespace arcsim {

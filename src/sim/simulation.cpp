@@ -5,10 +5,10 @@
 #include <cmath>
 #include <sstream>
 
-#include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "math/errors.hpp"
 #include "plasticity/plastic_step.hpp"
-#include "remesh/remesh_cloth.hpp"
+#include "sim/remesh_cloth.hpp"
 
 namespace arcsim {
 
@@ -45,8 +45,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   if (scene_.enabled("remeshing") && scene_.magic.fixed_high_res_mesh) {
     const RemeshOptions options = remesh_options(scene_);
     for (size_t c = 0; c < cloths.size(); ++c) {
-      refine_to_size_min(cloths[c], options);
-      compact_cloth(static_cast<int>(c));
+      const RemeshStats stats = refine_to_size_min(cloths[c], options);
+      topology_changed(static_cast<int>(c), edited(stats));
     }
   }
   move_obstacles(0);
@@ -345,9 +345,17 @@ void Simulation::remeshing_step() {
       if (other != c) options.obstacles.push_back(&cloths[other].mesh);
     remesh_stats[c] = remesh(cloths[c], nullptr, options);
     remesh_stats[c].active_faces.clear();
-    compact_cloth(static_cast<int>(c));
+    topology_changed(static_cast<int>(c), edited(remesh_stats[c]));
   }
   check_state();
+}
+
+void Simulation::topology_changed(int c, bool edited) {
+  Cloth& cloth = cloths[c];
+  // Reprojection alone only moves world positions, which the element cache does not hold.
+  if (edited) cloth.elements_dirty = true;
+  update_node_masses(cloth.mesh, cloth.materials);
+  compact_cloth(c);
 }
 
 void Simulation::compact_cloth(int c) {

@@ -102,15 +102,18 @@ class Simulation {
   // at each frame's first step, so after advance_frame() it is the work of that frame.
   std::vector<double> plastic_work;
   // Per cloth, the operation counts of the last frame-end remeshing pass (active_faces left empty). Mesh sizes
-  // for the log: remesh/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
+  // for the log: sim/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
   std::vector<RemeshStats> remesh_stats;
   // Energy audit, off by default (tests, diagnostics): fills step_energies (per cloth) in every step, at the
   // cost of one extra element build per cloth and plastic step. The step itself is unchanged by it.
   bool audit_energy = false;
   std::vector<StepEnergies> step_energies;
 
-  // After topology edits of cloth c: drops the dead elements and remaps the handles' node indices.
-  void compact_cloth(int c);
+  // The one follow-up after edits of cloth c (remeshing, fracture: every client of edit/edit_session.hpp calls
+  // it after a batch of edits): node masses from the current faces; if `edited` (some topology edit succeeded),
+  // the element cache and the solver's pattern are rebuilt before the next solve; dead elements are dropped and
+  // the handles' node indices remapped.
+  void topology_changed(int c, bool edited);
 
   // Overrides of the scene's end (command-line options); infinity keeps the scene's value.
   void set_end_time(double t) { end_time_ = t; }
@@ -137,6 +140,8 @@ class Simulation {
   // Frame-end remeshing of every cloth (module "remeshing", unless the mesh is fixed), then compaction.
   void remeshing_step();
   void check_state() const;
+  // Drops cloth c's dead elements and remaps the handles' node indices (part of topology_changed).
+  void compact_cloth(int c);
   // With audit_energy: records every cloth's mechanical energy into the field `phase` of step_energies; the
   // energy after plasticity is measured with a fresh element cache (the flow rules changed the rest state).
   void audit(double StepEnergies::*phase, bool fresh_elements = false);

@@ -7,8 +7,8 @@
 #include <random>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 namespace {

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/obj.hpp"
+#include "math/errors.hpp"
 #include "mesh/validate.hpp"
 
 namespace arcsim {

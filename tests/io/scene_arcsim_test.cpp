@@ -9,8 +9,8 @@
 #include <fstream>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 namespace {

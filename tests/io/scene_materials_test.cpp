@@ -8,8 +8,8 @@
 #include <map>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 namespace {

@@ -10,8 +10,8 @@
 #include <functional>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 namespace {

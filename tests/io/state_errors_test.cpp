@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
 #include "io/state.hpp"
+#include "math/errors.hpp"
 #include "sim/simulation.hpp"
 #include "support/files.hpp"
 

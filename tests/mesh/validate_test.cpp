@@ -4,7 +4,7 @@
 
 #include <functional>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "mesh/validate.hpp"
 #include "mesh_fixtures.hpp"
 

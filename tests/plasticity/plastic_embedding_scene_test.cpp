@@ -7,11 +7,11 @@
 #include <fstream>
 #include <string>
 
-#include "io/errors.hpp"
 #include "io/scene_parser.hpp"
+#include "math/errors.hpp"
 #include "plasticity/plastic_tensors.hpp"
 #include "remesh/remesh.hpp"
-#include "remesh/remesh_cloth.hpp"
+#include "sim/remesh_cloth.hpp"
 #include "support/mesh_factory.hpp"
 
 namespace arcsim {

@@ -13,7 +13,7 @@
 #include "collision/scene_fixtures.hpp"
 #include "io/scene_parser.hpp"
 #include "mesh/validate.hpp"
-#include "remesh/remesh_cloth.hpp"
+#include "sim/remesh_cloth.hpp"
 #include "sim/simulation.hpp"
 
 namespace arcsim {
@@ -112,7 +112,7 @@ double max_distance_to_surface(const Mesh& from, const Mesh& to, double cell) {
 }
 
 // square-pop: a sheet of paper held at its four corners and pushed together (buckling), remeshed every frame
-// without ARCSim's pop filter. Remeshing runs here as in Simulation (remesh + compact_cloth at every frame end)
+// without ARCSim's pop filter. Remeshing runs here as in Simulation (remesh + topology_changed at every frame end)
 // so that the world surface can be compared before and after it. A pop is remeshing moving the surface: new or
 // reprojected nodes away from the old surface, removed nodes away from the new one. The largest such jump over
 // the frames must stay below 10% of the typical motion: the median over frames of the largest node
@@ -134,8 +134,7 @@ TEST(ArcsimRemeshPop, SlowSquarePopDoesNotPop) {
     double moved = 0;
     for (size_t i = 0; i < start.size(); ++i) moved = std::max(moved, (cloth.mesh.nodes[i].x - start[i]).norm());
     const Mesh before = cloth.mesh;
-    remesh(cloth, nullptr, options);
-    sim.compact_cloth(0);
+    sim.topology_changed(0, edited(remesh(cloth, nullptr, options)));
     ASSERT_EQ(check_mesh(cloth.mesh), "");
     if (sim.time() < 1.0) continue;  // the handles start moving at t = 1 s
     motion.push_back(moved);

@@ -9,8 +9,8 @@
 
 #include "io/obj.hpp"
 #include "mesh/validate.hpp"
-#include "remesh/remesh_cloth.hpp"
 #include "remesh/remesh_fixtures.hpp"
+#include "sim/remesh_cloth.hpp"
 #include "sim/simulation.hpp"
 #include "support/mesh_factory.hpp"
 

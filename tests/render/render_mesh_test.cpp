@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "mesh/mesh.hpp"
 
 namespace arcsim {

@@ -7,7 +7,7 @@
 #include <memory>
 #include <unistd.h>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 
 namespace arcsim {
 namespace {

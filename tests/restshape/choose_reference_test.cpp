@@ -6,7 +6,7 @@
 
 #include <unistd.h>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "restshape/reference_surface.hpp"
 #include "restshape/sphere_fit.hpp"
 #include "restshape/surface_fixtures.hpp"

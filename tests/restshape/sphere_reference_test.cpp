@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "io/errors.hpp"
+#include "math/errors.hpp"
 #include "restshape/reference_surface.hpp"
 #include "restshape/sphere_fit.hpp"
 #include "restshape/surface_fixtures.hpp"

@@ -10,8 +10,8 @@
 #include <filesystem>
 
 #include "io/obj.hpp"
-#include "remesh/remesh_cloth.hpp"
 #include "remesh/remesh_fixtures.hpp"
+#include "sim/remesh_cloth.hpp"
 #include "sim/simulation.hpp"
 #include "support/mesh_factory.hpp"
 

@@ -1,9 +1,8 @@
-#include "remesh/remesh_cloth.hpp"
+#include "sim/remesh_cloth.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "physics/cloth_physics.hpp"
 
 namespace arcsim {
 
@@ -24,12 +23,10 @@ RemeshStats remesh(Cloth& cloth, const std::vector<int>* face_subset, const Reme
   RemeshOptions o = options;
   o.sizing.remeshing = cloth.remeshing;
   o.reference = cloth.reference.get();
-  const RemeshStats stats = remesh_mesh(cloth.mesh, cloth.materials, o, face_subset);
-  // Reprojection only moves world positions, which the element cache does not hold.
-  if (stats.splits + stats.flips + stats.collapses > 0) cloth.elements_dirty = true;
-  update_node_masses(cloth.mesh, cloth.materials);
-  return stats;
+  return remesh_mesh(cloth.mesh, cloth.materials, o, face_subset);
 }
+
+bool edited(const RemeshStats& stats) { return stats.splits + stats.flips + stats.collapses > 0; }
 
 RemeshStats refine_to_size_min(Cloth& cloth, const RemeshOptions& options) {
   const double size = cloth.remeshing.size_min;

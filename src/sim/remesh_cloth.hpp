@@ -17,9 +17,12 @@ namespace arcsim {
 RemeshOptions remesh_options(const Scene& scene);
 
 // Remeshes one cloth (see remesh_mesh) with its own remeshing parameters and reference surface (those fields of
-// `options` are overridden). Marks the cloth's elements dirty and recomputes its node masses. Does not compact:
-// the caller compacts (and remaps what holds node indices, see remap_handles).
+// `options` are overridden). The caller follows up with Simulation::topology_changed(c, edited(stats)) (masses,
+// element cache, compaction, handles).
 RemeshStats remesh(Cloth& cloth, const std::vector<int>* face_subset, const RemeshOptions& options);
+
+// Whether the pass changed the topology (a split, flip or collapse succeeded).
+bool edited(const RemeshStats& stats);
 
 // ARCSim's `fixed_high_res_mesh`: one isotropic remesh of the whole cloth to its size_min (nothing else enters
 // the sizing). Does nothing if size_min is not finite and positive.
