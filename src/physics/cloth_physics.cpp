@@ -341,6 +341,20 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
   }
 }
 
+VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,
+                      StepTiming& timing) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!solver.factorize(system))
+    throw NumericalError(step + ": the system matrix is not positive definite (CHOLMOD factorisation failed); "
+                         "the simulation is unstable");
+  const auto t1 = std::chrono::steady_clock::now();
+  VecX dv = solver.solve(system.rhs);
+  if (!dv.allFinite()) throw NumericalError(step + ": velocity update is not finite");
+  timing.factorization += std::chrono::duration<double>(t1 - t0).count();
+  timing.solve += seconds_since(t1);
+  return dv;
+}
+
 void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver, const ExternalLoads& loads,
                          double dt, StepTiming* timing) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -359,13 +373,9 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
     for (int i = 0; i < n; ++i)
       if (loads.pinned[i]) system.rhs.segment<3>(3 * i).setZero();
   }
-  const auto t1 = std::chrono::steady_clock::now();
-  if (!solver.factorize(system))
-    throw NumericalError("implicit step: the system matrix is not positive definite (CHOLMOD factorisation "
-                         "failed); the simulation is unstable");
-  const auto t2 = std::chrono::steady_clock::now();
-  const VecX dv = solver.solve(system.rhs);
-  if (!dv.allFinite()) throw NumericalError("implicit step: velocity update is not finite");
+  StepTiming times;
+  times.assembly = seconds_since(t0);
+  const VecX dv = factor_and_solve(solver, system, "implicit step", times);
   for (int i = 0; i < n; ++i) {
     Node& node = mesh.nodes[i];
     node.v += dv.segment<3>(3 * i);
@@ -374,9 +384,9 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
     node.x += dt * node.v;
   }
   if (timing) {
-    timing->assembly += std::chrono::duration<double>(t1 - t0).count();
-    timing->factorization += std::chrono::duration<double>(t2 - t1).count();
-    timing->solve += seconds_since(t2);
+    timing->assembly += times.assembly;
+    timing->factorization += times.factorization;
+    timing->solve += times.solve;
   }
 }
 

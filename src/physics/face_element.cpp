@@ -1,5 +1,6 @@
 #include "physics/face_element.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "physics/plate_bending.hpp"
@@ -54,6 +55,19 @@ Mat3 face_bending_matrix(const Mesh& mesh, const Material& material, int f, cons
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) Q(i, j) *= std::sqrt(kb[i] * kb[j]);
   return Q;
+}
+
+std::vector<int> bending_faces_of_node(const Mesh& mesh, int n) {
+  std::vector<int> faces = mesh.node_faces(n);
+  const size_t own = faces.size();
+  for (size_t k = 0; k < own; ++k) {
+    const int f = faces[k];
+    const int across = mesh.other_face(mesh.faces[f].e[(mesh.corner_of_node(f, n) + 1) % 3], f);
+    if (across != kNone) faces.push_back(across);
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
 }
 
 FaceElement make_face_element(const Mesh& mesh, const std::vector<Material>& materials, int f) {

@@ -67,6 +67,10 @@ struct BendingElement {
   double damping;             // beta (s)
 };
 
+// The faces whose bending element reads node n (sorted): its own faces and the faces across the edges opposite
+// it (n is their wing). Its membrane elements are those of Mesh::node_faces.
+std::vector<int> bending_faces_of_node(const Mesh& mesh, int n);
+
 // The elements of face f with dofs = nodes and no block ids yet.
 FaceElement make_face_element(const Mesh& mesh, const std::vector<Material>& materials, int f);
 BendingElement make_bending_element(const Mesh& mesh, const std::vector<Material>& materials, int f);

@@ -22,20 +22,11 @@ struct Elements {
 
 Elements gather_elements(const Mesh& mesh, const std::vector<Material>& materials, int node) {
   Elements els;
-  const std::vector<int> incident = mesh.node_faces(node);
-  std::vector<int> bending_faces = incident;
-  for (int f : incident) {
-    const Face& face = mesh.faces[f];
-    const int c = mesh.corner_of_node(f, node);
-    // The face across the edge opposite the node has the node as a wing.
-    const int across = mesh.other_face(face.e[(c + 1) % 3], f);
-    if (across != kNone) bending_faces.push_back(across);
+  for (int f : mesh.node_faces(node)) {
     els.membrane.push_back(make_face_element(mesh, materials, f));
-    els.mass += face_corner_mass(face, materials[face.material]);
+    els.mass += face_corner_mass(mesh.faces[f], materials[mesh.faces[f].material]);
   }
-  std::sort(bending_faces.begin(), bending_faces.end());
-  bending_faces.erase(std::unique(bending_faces.begin(), bending_faces.end()), bending_faces.end());
-  for (int f : bending_faces) els.bending.push_back(make_bending_element(mesh, materials, f));
+  for (int f : bending_faces_of_node(mesh, node)) els.bending.push_back(make_bending_element(mesh, materials, f));
   return els;
 }
 
