@@ -88,16 +88,14 @@ BendingElement make_bending_element(const Mesh& mesh, const std::vector<Material
   const Face& face = mesh.faces[f];
   const Material& material = materials[face.material];
   BendingElement b;
+  for (int i = 0; i < 3; ++i) b.nodes[i] = mesh.face_node(f, i);
   for (int i = 0; i < 3; ++i) {
     const int e = face.e[i];
-    b.nodes[i] = mesh.face_node(f, i);
     const int other = mesh.other_face(e, f);
     b.has_wing[i] = other != kNone;
     b.nodes[3 + i] = other != kNone ? mesh.opposite_node(e, other) : b.nodes[0];
     b.rest_theta[i] = mesh.edges[e].rest_theta;
   }
-  for (int i = 0; i < 3; ++i)
-    if (!b.has_wing[i]) b.nodes[3 + i] = b.nodes[0];
   b.dofs = b.nodes;
   b.blocks.fill(-1);
   b.Q = face_bending_matrix(mesh, material, f, b.has_wing);
