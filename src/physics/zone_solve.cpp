@@ -32,6 +32,14 @@ std::array<int, N> dofs_of(const std::array<int, N>& nodes, const SystemDofs& do
   return out;
 }
 
+// An element with its rows set to the zone's (-1 for fixed nodes); its row pairs go to `pairs`.
+template <typename Element>
+Element with_zone_rows(Element el, const SystemDofs& dofs, std::vector<std::pair<int, int>>& pairs) {
+  el.dofs = dofs_of(el.nodes, dofs);
+  add_dof_pairs(el.dofs, pairs);
+  return el;
+}
+
 }  // namespace
 
 std::vector<int> node_rings(const Mesh& mesh, const std::vector<int>& nodes, int rings) {
@@ -105,19 +113,11 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
   bending.reserve(bending_faces.size());
   std::vector<std::pair<int, int>> pairs;
   std::vector<int> support;
-  for (int f : membrane_faces) {
-    FaceElement el = make_face_element(mesh, materials, f);
-    el.dofs = dofs_of(el.nodes, dofs);
-    add_dof_pairs(el.dofs, pairs);
-    faces.push_back(el);
-  }
+  for (int f : membrane_faces) faces.push_back(with_zone_rows(make_face_element(mesh, materials, f), dofs, pairs));
   for (int f : bending_faces) {
-    BendingElement el = make_bending_element(mesh, materials, f);
-    el.dofs = dofs_of(el.nodes, dofs);
-    add_dof_pairs(el.dofs, pairs);
+    bending.push_back(with_zone_rows(make_bending_element(mesh, materials, f), dofs, pairs));
     for (int i = 0; i < 6; ++i)
-      if (el.dofs[i] < 0) support.push_back(el.nodes[i]);
-    bending.push_back(el);
+      if (bending.back().dofs[i] < 0) support.push_back(bending.back().nodes[i]);
   }
   for (const ContactTerm& c : loads.contacts) add_dof_pairs(dofs_of(c.nodes, dofs), pairs);
 
