@@ -55,7 +55,8 @@ struct BlockSystem {
   VecX rhs;
 
   void reset(const BlockPattern& p);
-  // Adds an element matrix over `nodes` (N nodes, 3N x 3N) scaled by `scale`. Only the lower blocks are read.
+  // Adds an element matrix over rows `nodes` (N nodes, 3N x 3N) scaled by `scale`. Only the lower blocks are
+  // read; rows -1 (nodes held fixed) are skipped.
   template <int N>
   void add_element(const std::array<int, N>& nodes, const std::array<int, N * N>& block_ids,
                    const Eigen::Matrix<double, 3 * N, 3 * N>& K, double scale);
@@ -66,12 +67,14 @@ struct BlockSystem {
   void to_csc(Eigen::SparseMatrix<double>& out) const;
 };
 
-// Looks up the block ids of all node pairs of an element once per topology.
+// Looks up the block ids of all row pairs of an element once per topology (-1 where a row is -1: a node held
+// fixed, see physics/system_dofs.hpp).
 template <int N>
-std::array<int, N * N> element_block_ids(const BlockPattern& p, const std::array<int, N>& nodes) {
+std::array<int, N * N> element_block_ids(const BlockPattern& p, const std::array<int, N>& rows) {
   std::array<int, N * N> ids{};
   for (int a = 0; a < N; ++a)
-    for (int b = 0; b < N; ++b) ids[a * N + b] = p.block_index(nodes[a], nodes[b]);
+    for (int b = 0; b < N; ++b)
+      ids[a * N + b] = (rows[a] < 0 || rows[b] < 0) ? -1 : p.block_index(rows[a], rows[b]);
   return ids;
 }
 
@@ -80,6 +83,7 @@ void BlockSystem::add_element(const std::array<int, N>& nodes, const std::array<
                               const Eigen::Matrix<double, 3 * N, 3 * N>& K, double scale) {
   for (int a = 0; a < N; ++a) {
     for (int b = 0; b < N; ++b) {
+      if (nodes[a] < 0 || nodes[b] < 0) continue;
       // Each unordered pair once: take (a, b) where node a is the block's row (>= column).
       if (nodes[a] < nodes[b]) continue;
       if (nodes[a] == nodes[b] && a != b) continue;  // repeated node (degenerate element): skip safely

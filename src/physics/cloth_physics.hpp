@@ -4,36 +4,24 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "mesh/mesh.hpp"
 #include "physics/block_system.hpp"
+#include "physics/face_element.hpp"
 #include "physics/material.hpp"
+#include "physics/system_dofs.hpp"
 #include "scene/scene.hpp"
 
 namespace arcsim {
 
-// Per-topology data of the physics: element node lists, hinge weights and block ids. Rebuilt whenever the
-// mesh topology or rest state changes (after remeshing, fracture or plastic updates).
+// Per-topology data of the physics: element node lists, element data (physics/face_element.hpp) and block ids.
+// Rebuilt whenever the mesh topology or rest state changes (after remeshing, fracture or plastic updates).
 struct ElementCache {
-  struct FaceElement {
-    std::array<int, 3> nodes;
-    std::array<int, 9> blocks;
-    Mat2 Dm_inv;            // includes plastic stretch: F_el = F Fp
-    double area;            // rest area (m^2)
-    MembraneStiffness k;    // N/m, already weakened
-    double damping;         // beta (s)
-  };
-  // Plate bending of one face (physics/plate_bending.hpp): corners then the wings across its three edges.
-  struct BendingElement {
-    std::array<int, 6> nodes;  // c0, c1, c2, w0, w1, w2 (a missing wing repeats c0; has_wing says which)
-    std::array<bool, 3> has_wing;
-    std::array<int, 36> blocks;
-    Vec3 rest_theta;        // rad, per edge
-    Mat3 Q;                 // J/rad^2, see plate_bending_matrix
-    double damping;         // beta (s)
-  };
+  using FaceElement = arcsim::FaceElement;
+  using BendingElement = arcsim::BendingElement;
   std::vector<FaceElement> faces;
   std::vector<BendingElement> bending;
   BlockPattern pattern;
@@ -88,6 +76,10 @@ struct InternalAssembly {
 // Returns the elastic energy.
 double assemble_internal(const Mesh& mesh, const ElementCache& cache, const InternalAssembly& how,
                          BlockSystem& system);
+// The same over any element lists (a zone's): rows and blocks from the elements' dofs and block ids.
+double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& faces,
+                              const std::vector<BendingElement>& bending, const InternalAssembly& how,
+                              BlockSystem& system);
 
 // External loads of one step.
 struct HandleSpring {
@@ -111,6 +103,23 @@ double mechanical_energy(const Mesh& mesh, const ElementCache& cache, const Exte
 struct StepTiming {
   double assembly = 0, factorization = 0, solve = 0;  // wall seconds
 };
+
+// Assembles the linearised backward Euler system of one step of size dt (s) over the rows of `dofs`:
+//   (M + dt (dt + beta) H - dt D_v) dv = dt [ f - (dt + beta) H v + f_ext ]
+// from `faces` and `bending` (their dofs and block ids must refer to `dofs` and system's pattern), the node
+// masses, gravity, the handle springs and contacts of rows of `dofs`, and air drag on `faces`. Fixed nodes
+// (dof -1) enter with their positions and velocities only. Pinned nodes are not treated here: the full step
+// makes them Dirichlet rows afterwards; a zone solve leaves them out of `dofs`. Shared by implicit_euler_step and
+// solve_zone (physics/zone_solve.hpp). Blocks in kg, rhs in N s.
+void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
+                             const std::vector<BendingElement>& bending, const SystemDofs& dofs,
+                             const ExternalLoads& loads, double dt, BlockSystem& system);
+
+// Factorises the assembled system and solves it for dv, adding the wall times to timing.factorization and
+// timing.solve. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the
+// matrix is not positive definite or dv is not finite.
+VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,
+                      StepTiming& timing);
 
 // One implicit Euler step of size dt (s): solves for the velocity change, then v += dv, a = dv/dt, x0 = x,
 // x += v dt. Throws NumericalError if the system cannot be factorised or the result is not finite.

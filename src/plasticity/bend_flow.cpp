@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "physics/bending.hpp"
+#include "physics/face_element.hpp"
 
 namespace arcsim {
 
@@ -52,8 +53,8 @@ BendFlowResult apply_bend_flow(Mesh& mesh, int face, const Material& m) {
   // Plastic work at frozen positions and stiffness: A (M_old + M_new)/2 : (S_old - S_new), the face's plate
   // energy the update releases (exact for the quadratic energy). Direction-dependent (data-driven) stiffness
   // is averaged over the material axes.
-  const double kb = 0.5 * (m.bending_stiffness(f.thickness, 0) + m.bending_stiffness(f.thickness, M_PI / 2)) /
-                    (1.0 + m.weakening * f.damage);
+  const double kb = weakened_bending_stiffness(
+      0.5 * (m.bending_stiffness(f.thickness, 0) + m.bending_stiffness(f.thickness, M_PI / 2)), m, f.damage);
   const double nu = m.data_driven ? 0.0 : m.poisson_ratio;
   const Mat3 P = Mat3::Identity() - f.rest_normal * f.rest_normal.transpose();
   const Mat3 S_after = S_el - increment;

@@ -9,6 +9,7 @@
 #include <Eigen/SVD>
 
 #include "physics/bending.hpp"
+#include "physics/face_element.hpp"
 #include "physics/plate_bending.hpp"
 #include "plasticity/bend_flow.hpp"
 #include "plasticity/plastic_tensors.hpp"
@@ -128,26 +129,6 @@ bool face_embedded(const Mesh& m, const PlasticEmbedding& emb, int f) {
   return true;
 }
 
-// Plate-bending stiffness matrix of a face as the physics builds it (physics/cloth_physics.cpp), with the
-// face's own thickness and damage weakening.
-Mat3 bending_matrix(const Mesh& m, const Material& mat, int f, const std::array<bool, 3>& has_wing) {
-  const Face& face = m.faces[f];
-  std::array<double, 3> lengths, kb;
-  std::array<Vec3, 3> normals;
-  for (int i = 0; i < 3; ++i) {
-    const Vec3 d = m.verts[face.v[(i + 1) % 3]].u - m.verts[face.v[i]].u;
-    lengths[i] = d.norm();
-    normals[i] = lengths[i] > 0 ? Vec3(d.cross(face.rest_normal) / lengths[i]) : Vec3::Zero();
-    const double angle = std::atan2(face.rest_frame.col(1).dot(d), face.rest_frame.col(0).dot(d));
-    kb[i] = mat.bending_stiffness(face.thickness, angle) / (1.0 + mat.weakening * m.edges[face.e[i]].damage);
-  }
-  const double nu = mat.data_driven ? 0.0 : mat.poisson_ratio;
-  Mat3 Q = plate_bending_matrix(lengths, normals, face.rest_area, 1.0, nu, has_wing);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) Q(i, j) *= std::sqrt(kb[i] * kb[j]);
-  return Q;
-}
-
 // The rotation R of the polar decomposition A = S R (S symmetric positive), identity if A is degenerate.
 Mat2 polar_rotation(const Mat2& A) {
   const Eigen::JacobiSVD<Mat2> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -246,11 +227,11 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& m, const std::vector<Material>
     if (!face_embedded(m, emb, f)) continue;
     const Material& mat = materials[face.material];
     // Rest metric: the plastic one where a stretching flow rule made it, else the reference (see header).
-    const Mat2 Dm_inv =
-        has_stretch_plasticity(mat) ? Mat2(face.Dm_inv * face_plastic_stretch_2d(face)) : face.Dm_inv;
+    const Mat2 Dm_inv = has_stretch_plasticity(mat) ? face_elastic_dm_inv(face) : face.Dm_inv;
     const MembraneTerms t =
         membrane_terms(position(m.face_node(f, 0)), position(m.face_node(f, 1)), position(m.face_node(f, 2)),
-                       Dm_inv, face.rest_area, mat.membrane_stiffness(face.thickness), 1.0, kind);
+                       Dm_inv, face.rest_area, face_membrane_stiffness(face, mat, MembraneWeakening::kIgnored),
+                       1.0, kind);
     out.energy += t.energy;
     const int c = m.corner_of_node(f, node);
     out.gradient += t.gradient.segment<3>(3 * c);
@@ -277,7 +258,7 @@ PlasticNodeEnergy plastic_node_energy(const Mesh& m, const std::vector<Material>
       // plastic_embedding_test.cpp's patch test).
       rest[i] = m.edges[face.e[i]].rest_theta;
     }
-    const Mat3 Q = bending_matrix(m, materials[face.material], f, has_wing);
+    const Mat3 Q = face_bending_matrix(m, materials[face.material], f, has_wing);
     std::array<Vec3, 6> xs;
     for (int i = 0; i < 6; ++i) xs[i] = position(nodes[i]);
     const PlateBendingTerms t = plate_bending_terms(xs, has_wing, rest, Q, kind);

@@ -120,11 +120,6 @@ void update_edge_damage_from_faces(Mesh& mesh, const std::vector<int>& edges) {
   }
 }
 
-Mat2 face_plastic_stretch_2d(const Face& face) {
-  if (face.Fp.isIdentity(0)) return Mat2::Identity();
-  return face.rest_frame.transpose() * face.Fp * face.rest_frame;
-}
-
 Mat3 face_plastic_stretch_3d(const Face& face, const Mat2& Fp2) {
   if (Fp2.isIdentity(0)) return Mat3::Identity();
   return face.rest_frame * Fp2 * face.rest_frame.transpose() + face.rest_normal * face.rest_normal.transpose();

@@ -14,6 +14,7 @@
 
 #include "math/types.hpp"
 #include "mesh/mesh.hpp"
+#include "physics/face_element.hpp"  // face_plastic_stretch_2d
 
 namespace arcsim {
 
@@ -30,8 +31,8 @@ void update_edge_rest_angles_from_Sp(Mesh& mesh, const std::vector<int>& edges);
 // Sets edge.damage to the mean damage of its live faces, as ARCSim does (all live edges if empty).
 void update_edge_damage_from_faces(Mesh& mesh, const std::vector<int>& edges);
 
-// Fp of a face in its 2D material frame (rest_frame^T Fp rest_frame), and back to the 3D embedding.
-Mat2 face_plastic_stretch_2d(const Face& face);
+// The 3D embedding of a face's 2D plastic tensor (face_plastic_stretch_2d, physics/face_element.hpp, is the
+// other way).
 Mat3 face_plastic_stretch_3d(const Face& face, const Mat2& Fp2);
 
 }  // namespace arcsim

@@ -5,20 +5,13 @@
 
 #include <Eigen/SVD>
 
+#include "physics/face_element.hpp"
 #include "physics/membrane.hpp"
 #include "plasticity/plastic_tensors.hpp"
 
 namespace arcsim {
 
 namespace {
-
-// Membrane stiffness (N/m) the physics uses for this face: the thickness-scaled one, weakened by damage.
-MembraneStiffness face_membrane_stiffness(const Face& f, const Material& m) {
-  MembraneStiffness k = m.membrane_stiffness(f.thickness);
-  const double w = 1.0 / (1.0 + m.weakening * f.damage);
-  k.k11 *= w, k.k12 *= w, k.k22 *= w, k.k33 *= w;
-  return k;
-}
 
 Mat2 green_strain(const Mat32& F) { return 0.5 * (F.transpose() * F - Mat2::Identity()); }
 
@@ -73,7 +66,7 @@ StretchFlowResult apply_stretch_flow(Mesh& mesh, int face, const Material& m, do
   const Vec3& x2 = mesh.nodes[mesh.face_node(face, 2)].x;
   const Mat2 Fp_old = face_plastic_stretch_2d(f);
   const Mat32 F_el = membrane_deformation_gradient(x0, x1, x2, f.Dm_inv * Fp_old);
-  const MembraneStiffness k = face_membrane_stiffness(f, m);
+  const MembraneStiffness k = face_membrane_stiffness(f, m);  // as the physics sees it
   const Mat2 G_old = green_strain(F_el);
   const Mat2 S_old = membrane_stress(G_old, k);  // N/m
   out.von_mises = von_mises_plane_stress(S_old / f.thickness);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "physics/bending.hpp"
+#include "physics/face_element.hpp"
 #include "physics/membrane.hpp"
 #include "physics/plate_bending.hpp"
 
@@ -12,87 +13,20 @@ namespace arcsim {
 
 namespace {
 
-// The same per-face element data as the physics' element cache (physics/cloth_physics.cpp), for the few faces
-// around one node.
-struct MembraneElement {
-  std::array<int, 3> nodes;
-  Mat2 Dm_inv;  // includes the plastic stretch
-  double area;
-  MembraneStiffness k;
-};
-
-struct BendingElement {
-  std::array<int, 6> nodes;  // corners, then wings (a missing wing repeats corner 0)
-  std::array<bool, 3> has_wing;
-  Vec3 rest_theta;
-  Mat3 Q;
-};
-
+// The node's elements, built as the physics builds them (physics/face_element.hpp).
 struct Elements {
-  std::vector<MembraneElement> membrane;
+  std::vector<FaceElement> membrane;
   std::vector<BendingElement> bending;
   double mass = 0;  // kg
 };
 
-MembraneElement membrane_element(const Mesh& mesh, const std::vector<Material>& materials, int f) {
-  const Face& face = mesh.faces[f];
-  const Material& m = materials[face.material];
-  MembraneElement el;
-  for (int i = 0; i < 3; ++i) el.nodes[i] = mesh.face_node(f, i);
-  const Mat2 Fp =
-      face.Fp.isIdentity(0) ? Mat2::Identity() : Mat2(face.rest_frame.transpose() * face.Fp * face.rest_frame);
-  el.Dm_inv = face.Dm_inv * Fp;
-  el.area = face.rest_area;
-  el.k = m.membrane_stiffness(face.thickness);
-  const double w = 1.0 / (1.0 + m.weakening * face.damage);
-  el.k.k11 *= w, el.k.k12 *= w, el.k.k22 *= w, el.k.k33 *= w;
-  return el;
-}
-
-BendingElement bending_element(const Mesh& mesh, const std::vector<Material>& materials, int f) {
-  const Face& face = mesh.faces[f];
-  const Material& m = materials[face.material];
-  BendingElement b;
-  std::array<double, 3> lengths, kb;
-  std::array<Vec3, 3> normals;
-  for (int i = 0; i < 3; ++i) {
-    const int e = face.e[i];
-    b.nodes[i] = mesh.face_node(f, i);
-    const int other = mesh.other_face(e, f);
-    b.has_wing[i] = other != kNone;
-    b.nodes[3 + i] = other != kNone ? mesh.opposite_node(e, other) : kNone;
-    b.rest_theta[i] = mesh.edges[e].rest_theta;
-    const Vec3 d = mesh.verts[face.v[(i + 1) % 3]].u - mesh.verts[face.v[i]].u;
-    lengths[i] = d.norm();
-    normals[i] = lengths[i] > 0 ? Vec3(d.cross(face.rest_normal) / lengths[i]) : Vec3::Zero();
-    const double angle = std::atan2(face.rest_frame.col(1).dot(d), face.rest_frame.col(0).dot(d));
-    kb[i] = m.bending_stiffness(face.thickness, angle) / (1.0 + m.weakening * mesh.edges[e].damage);
-  }
-  for (int i = 0; i < 3; ++i)
-    if (!b.has_wing[i]) b.nodes[3 + i] = b.nodes[0];
-  const double nu = m.data_driven ? 0.0 : m.poisson_ratio;
-  b.Q = plate_bending_matrix(lengths, normals, face.rest_area, 1.0, nu, b.has_wing);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) b.Q(i, j) *= std::sqrt(kb[i] * kb[j]);
-  return b;
-}
-
 Elements gather_elements(const Mesh& mesh, const std::vector<Material>& materials, int node) {
   Elements els;
-  const std::vector<int> incident = mesh.node_faces(node);
-  std::vector<int> bending_faces = incident;
-  for (int f : incident) {
-    const Face& face = mesh.faces[f];
-    const int c = mesh.corner_of_node(f, node);
-    // The face across the edge opposite the node has the node as a wing.
-    const int across = mesh.other_face(face.e[(c + 1) % 3], f);
-    if (across != kNone) bending_faces.push_back(across);
-    els.membrane.push_back(membrane_element(mesh, materials, f));
-    els.mass += materials[face.material].area_density(face.thickness) * face.rest_area / 3;
+  for (int f : mesh.node_faces(node)) {
+    els.membrane.push_back(make_face_element(mesh, materials, f));
+    els.mass += face_corner_mass(mesh.faces[f], materials[mesh.faces[f].material]);
   }
-  std::sort(bending_faces.begin(), bending_faces.end());
-  bending_faces.erase(std::unique(bending_faces.begin(), bending_faces.end()), bending_faces.end());
-  for (int f : bending_faces) els.bending.push_back(bending_element(mesh, materials, f));
+  for (int f : bending_faces_of_node(mesh, node)) els.bending.push_back(make_bending_element(mesh, materials, f));
   return els;
 }
 
@@ -127,7 +61,7 @@ LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3
   LocalEnergy out;
   auto position = [&](int n) -> const Vec3& { return n == node ? x : mesh.nodes[n].x; };
   const HessianKind kind = with_hessian ? HessianKind::kProjected : HessianKind::kNone;
-  for (const MembraneElement& el : els.membrane) {
+  for (const FaceElement& el : els.membrane) {
     const MembraneTerms t = membrane_terms(position(el.nodes[0]), position(el.nodes[1]), position(el.nodes[2]),
                                            el.Dm_inv, el.area, el.k, 1.0, kind);
     out.energy += t.energy;
