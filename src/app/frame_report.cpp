@@ -61,6 +61,19 @@ std::string frame_log_line(const FrameReport& r) {
         .integer("unresolved_steps", z.unresolved_steps);
     line.object("impact_zones", zones);
   }
+  if (r.has_fracture) {
+    const FractureStats& f = r.fracture;
+    JsonLine fracture;
+    fracture.integer("cracks", f.cracks)
+        .integer("refused", f.refused)
+        .integer("substeps", f.substeps)
+        .integer("candidates", f.candidates)
+        .integer("largest_zone", f.largest_zone)
+        .integer("remesh_edits", f.remesh_edits)
+        .number("max_ratio", f.max_ratio)
+        .number("seconds", f.seconds);
+    line.object("fracture", fracture);
+  }
   return line.str();
 }
 
@@ -72,6 +85,7 @@ std::string progress_json_line(const FrameReport& r, double total_frames) {
       .integer("faces", r.faces)
       .integer("nodes", r.nodes)
       .number("wall", r.wall.total);
+  if (r.has_fracture) line.integer("cracks", r.fracture.cracks);
   return line.str();
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "collision/collision_step.hpp"  // ImpactZoneTotals
+#include "fracture/fracture_step.hpp"      // FractureStats
 
 namespace arcsim {
 
@@ -35,6 +36,8 @@ struct FrameReport {
   std::vector<double> plastic_work;  // J per cloth over the frame's steps; empty when plasticity is off
   bool has_impact_zones = false;     // the collision module ran: impact_zones below is meaningful
   ImpactZoneTotals impact_zones;     // summed over the frame's steps
+  bool has_fracture = false;         // the fracture module ran in this frame: fracture below is meaningful
+  FractureStats fracture;            // summed over the frame's steps and cloths
 };
 
 // {"frame":..,"time":..,"steps":..,"nodes":..,"faces":..,"saved":..,"wall":{"physics":..,...,"total":..}}, then
@@ -42,7 +45,9 @@ struct FrameReport {
 // "meshes":{"cloth0":{"faces":..,"edge_min":..,"edge_median":..,"edge_max":..[,"splits":..,"flips":..,
 // "collapses":..,"guarded":..]},...} (m) when meshes is not empty (the edit counts when remeshed),
 // then "impact_zones":{"steps":..,"impacts":..,"zones":..,"iterations":..,"largest_zone":..,"fallback_zones":..,
-// "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones.
+// "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones, then "fracture":{"cracks":..,
+// "refused":..,"substeps":..,"candidates":..,"largest_zone":..,"remesh_edits":..,"max_ratio":..,"seconds":..}
+// when has_fracture (max_ratio: the largest separation strength / toughness seen at a step's first evaluation).
 std::string frame_log_line(const FrameReport& report);
 
 // {"frame":..,"total":..,"time":..,"faces":..,"nodes":..,"wall":..}; total is null when the run is unbounded,

@@ -46,6 +46,7 @@ std::string Progress::status(const FrameReport& r) const {
   std::snprintf(buffer, sizeof buffer, "frame %d/%s  t = %.4g s  %lld faces  %.3g s/frame", r.frame,
                 total.c_str(), r.time, r.faces, per_frame);
   std::string text = buffer;
+  if (r.has_fracture) text += "  " + std::to_string(cracks_) + " cracks";
   if (bounded) text += "  ETA " + format_duration(per_frame * std::max(0.0, total_frames_ - r.frame));
   return text;
 }
@@ -53,6 +54,7 @@ std::string Progress::status(const FrameReport& r) const {
 void Progress::frame_done(const FrameReport& r) {
   ++frames_done_;
   wall_sum_ += r.wall.total;
+  cracks_ += r.has_fracture ? r.fracture.cracks : 0;
   switch (style_) {
     case ProgressStyle::kQuiet:
       return;

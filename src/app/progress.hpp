@@ -33,6 +33,7 @@ class Progress {
   double total_frames_;
   int frames_done_ = 0;
   double wall_sum_ = 0;       // s, over the frames reported so far
+  long long cracks_ = 0;      // cracks opened over the frames reported so far
   size_t live_width_ = 0;     // characters of the live line on screen
   long long last_bucket_ = -1;  // last 5% bucket printed in the lines style
 };

@@ -155,6 +155,9 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   if (sim.scene().enabled("plasticity")) report.plastic_work = sim.plastic_work;
   report.has_impact_zones = sim.scene().enabled("collision");
   report.impact_zones = sim.collision_totals();
+  // Fracture ran in this frame if it is active now or was before passive_time switched it off in this frame.
+  report.has_fracture = sim.scene().enabled("fracture") && !sim.fracture_stats.empty();
+  for (const FractureStats& f : sim.fracture_stats) report.fracture += f;
 }
 
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {

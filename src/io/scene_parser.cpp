@@ -348,6 +348,7 @@ class SceneParser {
     parse_timing(top);
     parse_disable(top.get("disable"));
     parse_magic(top.get("magic"));
+    parse_fracture(top.get("fracture"));
     parse_cloths(top.get("cloths"));
     parse_motions(top.get("motions"));
     parse_handles(top.get("handles"));
@@ -480,6 +481,17 @@ class SceneParser {
     m.relax_method = get_int(r.get("relax_method"), m.relax_method, 0, 1);
     m.max_cracks = get_int(r.get("max_cracks"), m.max_cracks, 0);
     m.enable_localopt = get_bool(r.get("enable_localopt"), m.enable_localopt);
+    r.warn_unknown();
+  }
+
+  void parse_fracture(const Found& f) {
+    if (!f) return;
+    FractureSpec& s = scene_.fracture;
+    ObjectReader r(*f.value, f.at, scene_.warnings);
+    s.zone_rings = get_int(r.get("zone_rings"), s.zone_rings, 1, 20);
+    s.substepping = get_bool(r.get("substepping"), s.substepping);
+    s.local_remesh = get_bool(r.get("local_remesh"), s.local_remesh);
+    s.reproject = get_bool(r.get("reproject"), s.reproject);
     r.warn_unknown();
   }
 

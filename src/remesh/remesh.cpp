@@ -143,7 +143,7 @@ class Remesher {
  public:
   Remesher(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
            const std::vector<int>* subset)
-      : m_(mesh), materials_(materials), o_(options), session_(mesh, materials, session_options(options), subset) {
+      : m_(mesh), materials_(materials), o_(options), session_(mesh, materials, edit_session_options(options), subset) {
     const RemeshingParams& r = o_.sizing.remeshing;
     aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
     min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
@@ -161,16 +161,6 @@ class Remesher {
   }
 
  private:
-  static EditSessionOptions session_options(const RemeshOptions& o) {
-    EditSessionOptions s;
-    s.reference = o.reference;
-    s.plastic_embedding = o.sizing.remeshing.plastic_embedding;
-    s.reproject = o.reproject;
-    s.reprojection = o.reprojection;
-    s.world_clearance = o.world_clearance;
-    s.obstacles = o.obstacles;
-    return s;
-  }
 
   bool is_active(int f) const { return session_.in_zone(f); }
 
@@ -407,6 +397,17 @@ class Remesher {
 };
 
 }  // namespace
+
+EditSessionOptions edit_session_options(const RemeshOptions& o) {
+  EditSessionOptions s;
+  s.reference = o.reference;
+  s.plastic_embedding = o.sizing.remeshing.plastic_embedding;
+  s.reproject = o.reproject;
+  s.reprojection = o.reprojection;
+  s.world_clearance = o.world_clearance;
+  s.obstacles = o.obstacles;
+  return s;
+}
 
 RemeshStats remesh_mesh(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
                         const std::vector<int>* face_subset) {

@@ -54,6 +54,10 @@ struct RemeshStats : EditCounts {
   std::vector<int> active_faces;
 };
 
+// The edit session options of remeshing (reference surface, plastic transfer, reprojection, world guard):
+// fracture's openings use the same.
+EditSessionOptions edit_session_options(const RemeshOptions& options);
+
 // Remeshes `mesh` (whole mesh, or only the edges of the faces in `face_subset` when it is not null; the edits
 // may still change faces just outside, as a split of a border edge must).
 RemeshStats remesh_mesh(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,

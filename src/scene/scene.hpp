@@ -87,6 +87,15 @@ struct MagicParams {
   bool enable_localopt = false;
 };
 
+// Fracture substepping settings (top-level "fracture" object; ours, not ARCSim's). max_cracks stays in "magic"
+// as in ARCSim.
+struct FractureSpec {
+  int zone_rings = 3;         // n-ring of Algorithm 1's zone
+  bool substepping = true;    // false: the paper's ablation (one evaluation, no virtual update)
+  bool local_remesh = true;   // refine the zone to size_min before predicting
+  bool reproject = true;      // Eq. 13 after each opening
+};
+
 struct Scene {
   std::string path;             // the scene file
   std::string base_dir;         // folder paths are resolved against first
@@ -108,6 +117,7 @@ struct Scene {
   double obs_friction = 0.3;
   std::set<std::string> disabled;  // module names
   MagicParams magic;
+  FractureSpec fracture;
   std::vector<std::string> referenced_files;  // every file the scene names (meshes, materials, motions)
   std::vector<std::string> warnings;          // e.g. unknown keys
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fracture/fracture_sizing.hpp"
 #include "io/obj.hpp"
 #include "math/errors.hpp"
 #include "plasticity/plastic_step.hpp"
@@ -36,6 +37,11 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   frame_steps_ = scene.frame_steps;
   end_time_ = scene.end_time;
   end_frame_ = scene.end_frame;
+  fracture.zone_rings = scene.fracture.zone_rings;
+  fracture.substepping = scene.fracture.substepping;
+  fracture.local_remesh = scene.fracture.local_remesh;
+  fracture.reproject = scene.fracture.reproject;
+  fracture.max_cracks = scene.magic.max_cracks;
   for (Motion& m : motions_) m.finalize();
   for (size_t i = 0; i < scene.cloths.size(); ++i) load_cloth(scene.cloths[i], static_cast<int>(i));
   for (size_t i = 0; i < scene.obstacles.size(); ++i) load_obstacle(scene.obstacles[i], static_cast<int>(i));
@@ -207,7 +213,7 @@ CollisionSettings Simulation::collision_settings() const {
   s.repulsion_thickness = magic.repulsion_thickness;
   s.projection_thickness =
       magic.projection_thickness >= 0 ? magic.projection_thickness : 0.1 * magic.repulsion_thickness;
-  s.stiffness = magic.collision_stiffness;
+  s.stiffness = magic.collision_stiffness * (passive() ? kPassiveStiffnessFactor : 1.0);
   s.friction = scene_.friction;
   s.obstacle_friction = scene_.obs_friction;
   s.step = step_;
@@ -261,8 +267,10 @@ void Simulation::check_state() const {
   }
 }
 
+double Simulation::current_step_time() const { return passive() ? kPassiveStepFactor * step_time_ : step_time_; }
+
 void Simulation::advance_step() {
-  const double dt = step_time_;
+  const double dt = current_step_time();
   time_ += dt;
   ++step_;
   move_obstacles(time_);
@@ -296,6 +304,10 @@ void Simulation::advance_step() {
   plasticity_step(dt);
   times.plasticity += seconds_since(t0);
   audit(&StepEnergies::after_plasticity, true);
+
+  t0 = std::chrono::steady_clock::now();
+  fracture_step(dt);
+  times.fracture += seconds_since(t0);
 
   if (step_ % frame_steps_ == 0) {
     t0 = std::chrono::steady_clock::now();
@@ -334,6 +346,33 @@ void Simulation::plasticity_step(double dt) {
   }
 }
 
+bool Simulation::fracture_active() const { return scene_.enabled("fracture") && !passive(); }
+
+void Simulation::fracture_step(double dt) {
+  fracture_stats.resize(cloths.size());
+  if ((step_ - 1) % frame_steps_ == 0) std::fill(fracture_stats.begin(), fracture_stats.end(), FractureStats());
+  if (!fracture_active()) return;
+  FractureContext context;
+  context.remesh = remesh_options(scene_);
+  context.dt = dt;
+  FractureParams params = fracture;
+  params.local_remesh = params.local_remesh && scene_.enabled("remeshing") && !scene_.magic.fixed_high_res_mesh;
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    Cloth& cloth = cloths[c];
+    if (!has_fracture(cloth.materials)) continue;
+    context.remesh.sizing.remeshing = cloth.remeshing;
+    context.remesh.reference = cloth.reference.get();
+    context.remesh.obstacles = active_obstacle_meshes(obstacles);
+    for (size_t other = 0; other < cloths.size(); ++other)
+      if (other != c) context.remesh.obstacles.push_back(&cloths[other].mesh);
+    context.loads = loads_for(static_cast<int>(c), time_);
+    const FractureStats s = arcsim::fracture_step(cloth.mesh, cloth.materials, params, context, cloth.zone_solver);
+    fracture_stats[c] += s;
+    topology_changed(static_cast<int>(c), s.edited);
+  }
+  check_state();
+}
+
 void Simulation::remeshing_step() {
   if (!scene_.enabled("remeshing") || scene_.magic.fixed_high_res_mesh) return;
   RemeshOptions options = remesh_options(scene_);
@@ -343,7 +382,14 @@ void Simulation::remeshing_step() {
     options.obstacles = active_obstacle_meshes(obstacles);
     for (size_t other = 0; other < cloths.size(); ++other)
       if (other != c) options.obstacles.push_back(&cloths[other].mesh);
+    // Fracture sizing (paper §5.1) while fracture runs.
+    std::vector<Mat3> fracture_terms;
+    if (fracture_active())
+      fracture_terms = fracture_sizing_terms(cloths[c].mesh, cloths[c].materials, cloths[c].remeshing.refine_fracture,
+                                             cloths[c].remeshing.size_min);
+    options.extras.face_terms = fracture_terms.empty() ? nullptr : &fracture_terms;
     remesh_stats[c] = remesh(cloths[c], nullptr, options);
+    options.extras.face_terms = nullptr;
     remesh_stats[c].active_faces.clear();
     topology_changed(static_cast<int>(c), edited(remesh_stats[c]));
   }
@@ -373,12 +419,16 @@ void Simulation::advance_frame() {
 
 bool Simulation::finished() const {
   // Half a step of slack so that accumulated rounding in `time_` does not add a step.
-  return time_ >= end_time_ - 0.5 * step_time_ || frame_ >= end_frame_;
+  return time_ >= end_time_ - 0.5 * current_step_time() || frame_ >= end_frame_;
 }
 
 double Simulation::total_frames() const {
   const double frame_time = step_time_ * frame_steps_;
-  return std::min(end_frame_, std::ceil(end_time_ / frame_time - 1e-9));
+  if (!(end_time_ > scene_.passive_time)) return std::min(end_frame_, std::ceil(end_time_ / frame_time - 1e-9));
+  // Frames before passive_time, then frames of the longer passive step.
+  const double active = std::ceil(scene_.passive_time / frame_time - 1e-9);
+  const double rest = std::ceil((end_time_ - active * frame_time) / (kPassiveStepFactor * frame_time) - 1e-9);
+  return std::min(end_frame_, active + std::max(rest, 0.0));
 }
 
 }  // namespace arcsim

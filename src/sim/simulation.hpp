@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "collision/collision_step.hpp"
+#include "fracture/fracture_step.hpp"
 #include "mesh/mesh.hpp"
 #include "physics/cloth_physics.hpp"
 #include "remesh/remesh.hpp"
@@ -17,6 +18,10 @@
 
 namespace arcsim {
 
+// ARCSim's passive_time switch: from then on no fracture, a longer step and softer collisions.
+constexpr double kPassiveStepFactor = 5;
+constexpr double kPassiveStiffnessFactor = 0.4;
+
 struct Cloth {
   Mesh mesh;
   std::vector<Material> materials;
@@ -24,6 +29,7 @@ struct Cloth {
   std::string source;           // mesh file, for messages
   ElementCache elements;        // physics data of the current topology
   CholeskySolver solver;
+  CholeskySolver zone_solver;   // fracture's zone solves (its own pattern, changed every solve)
   bool elements_dirty = true;   // topology or rest state changed since the cache was built
   std::shared_ptr<const ReferenceSurface> reference;  // where remeshing puts new rest positions (restshape/)
 };
@@ -79,7 +85,9 @@ class Simulation {
 
   const Scene& scene() const { return scene_; }
   double time() const { return time_; }
-  double step_time() const { return step_time_; }
+  double step_time() const { return step_time_; }  // the scene's time step (s)
+  // The step the next advance_step() takes (s): step_time(), or kPassiveStepFactor times it from passive_time on.
+  double current_step_time() const;
   int step() const { return step_; }
   int frame() const { return frame_; }
   int frame_steps() const { return frame_steps_; }
@@ -104,6 +112,16 @@ class Simulation {
   // Per cloth, the operation counts of the last frame-end remeshing pass (active_faces left empty). Mesh sizes
   // for the log: sim/remesh_cloth.hpp's mesh_size_stats(cloths[c].mesh).
   std::vector<RemeshStats> remesh_stats;
+  // Per cloth, what fracture substepping did in the steps of the current frame so far (reset at each frame's
+  // first step, like plastic_work).
+  std::vector<FractureStats> fracture_stats;
+  // Fracture parameters (from the scene; tests and the ablations of tools/ change them).
+  FractureParams fracture;
+  // Whether the fracture module runs at the current time: enabled in the scene, and before passive_time
+  // (ARCSim: from passive_time on, fracture is off, the time step 5x longer, the collision stiffness x0.4).
+  bool fracture_active() const;
+  bool passive() const { return time_ >= scene_.passive_time; }
+
   // Energy audit, off by default (tests, diagnostics): fills step_energies (per cloth) in every step, at the
   // cost of one extra element build per cloth and plastic step. The step itself is unchanged by it.
   bool audit_energy = false;
@@ -137,6 +155,9 @@ class Simulation {
   void collision_step(double dt);
   // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
   void plasticity_step(double dt);
+  // Fracture substepping of every breakable cloth (module "fracture", fracture/fracture_step.hpp), then the
+  // follow-up of topology_changed.
+  void fracture_step(double dt);
   // Frame-end remeshing of every cloth (module "remeshing", unless the mesh is fixed), then compaction.
   void remeshing_step();
   void check_state() const;

@@ -1,0 +1,249 @@
+#include "fracture/fracture_step.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "fracture/fracture_stress.hpp"
+#include "math/errors.hpp"
+#include "physics/zone_solve.hpp"
+
+namespace arcsim {
+
+FractureStats& FractureStats::operator+=(const FractureStats& o) {
+  cracks += o.cracks;
+  refused += o.refused;
+  substeps += o.substeps;
+  candidates += o.candidates;
+  largest_zone = std::max(largest_zone, o.largest_zone);
+  remesh_edits += o.remesh_edits;
+  max_ratio = std::max(max_ratio, o.max_ratio);
+  edited = edited || o.edited;
+  seconds += o.seconds;
+  return *this;
+}
+
+bool has_fracture(const std::vector<Material>& materials) {
+  return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.toughness > 0; });
+}
+
+namespace {
+
+struct Candidate {
+  NodeSeparation separation;
+  bool operator<(const Candidate& o) const {  // strongest first; ties by node index (determinism)
+    const double a = separation.ratio(), b = o.separation.ratio();
+    return a != b ? a > b : separation.node < o.separation.node;
+  }
+};
+
+// The breaking nodes among `nodes` (live ones, not refused in this step), strongest first.
+std::vector<Candidate> breaking_nodes(const Mesh& mesh, const std::vector<Material>& materials,
+                                      const std::vector<int>& nodes, const std::vector<FaceFractureStress>& stress,
+                                      const std::vector<char>& refused, const SeparationOptions& options) {
+  std::vector<Candidate> out;
+  for (int n : nodes) {
+    if (n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead) continue;
+    if (n < static_cast<int>(refused.size()) && refused[n]) continue;
+    NodeSeparation s = node_separation(mesh, materials, n, stress, options);
+    if (s.breaks()) out.push_back({std::move(s)});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<int> live_nodes(const Mesh& mesh) {
+  std::vector<int> out;
+  for (size_t n = 0; n < mesh.nodes.size(); ++n)
+    if (!mesh.nodes[n].dead) out.push_back(static_cast<int>(n));
+  return out;
+}
+
+// The faces of `nodes` (each once, sorted).
+std::vector<int> faces_of_nodes(const Mesh& mesh, const std::vector<int>& nodes) {
+  std::vector<int> faces;
+  for (int n : nodes)
+    for (int f : mesh.node_faces(n)) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+// The live faces with all three corners among `nodes` (sorted): the zone's interior, which the local remesh
+// refines (its border edges may be split too).
+std::vector<int> interior_faces(const Mesh& mesh, const std::vector<int>& nodes) {
+  std::vector<char> in(mesh.nodes.size(), 0);
+  for (int n : nodes) in[n] = 1;
+  std::vector<int> out;
+  for (int f : faces_of_nodes(mesh, nodes)) {
+    bool all = true;
+    for (int i = 0; i < 3; ++i) all = all && in[mesh.face_node(f, i)];
+    if (all) out.push_back(f);
+  }
+  return out;
+}
+
+std::vector<int> nodes_of_faces(const Mesh& mesh, const std::vector<int>& faces) {
+  std::vector<int> nodes;
+  for (int f : faces) {
+    if (f < 0 || f >= static_cast<int>(mesh.faces.size()) || mesh.faces[f].dead) continue;
+    for (int i = 0; i < 3; ++i) nodes.push_back(mesh.face_node(f, i));
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+double size_min_of(const FractureContext& context) {
+  const double s = context.remesh.sizing.remeshing.size_min;
+  return std::isfinite(s) && s > 0 ? s : 0;
+}
+
+CrackOpeningOptions opening_options(const FractureParams& params, const FractureContext& context) {
+  CrackOpeningOptions o = params.opening;
+  o.size_min = size_min_of(context);
+  return o;
+}
+
+EditSessionOptions session_options(const FractureParams& params, const FractureContext& context) {
+  EditSessionOptions o = edit_session_options(context.remesh);
+  o.reproject = params.reproject && o.reproject;
+  return o;
+}
+
+// Opens a crack at the candidate through a fresh edit session (the world guard sees the mesh as it is now).
+CrackOpening open_at(Mesh& mesh, const std::vector<Material>& materials, const Candidate& c,
+                     const FractureParams& params, const FractureContext& context, FractureStats& stats) {
+  EditSession session(mesh, materials, session_options(params, context));
+  CrackOpening opening = open_crack(session, c.separation.node, c.separation.rays, opening_options(params, context));
+  stats.edited = stats.edited || session.edited();
+  if (opening.ok)
+    ++stats.cracks;
+  else
+    ++stats.refused;
+  return opening;
+}
+
+// Step 2b: refines the zone's interior to size_min. Returns the zone's nodes after the edits.
+std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
+                             const FractureContext& context, FractureStats& stats) {
+  RemeshOptions o = context.remesh;
+  o.extras = SizingExtras();
+  o.extras.uniform_size = size_min_of(context);
+  const std::vector<int> faces = interior_faces(mesh, zone);
+  if (faces.empty()) return zone;
+  const RemeshStats r = remesh_mesh(mesh, materials, o, &faces);
+  const int edits = r.splits + r.flips + r.collapses;
+  if (edits == 0) return zone;
+  stats.remesh_edits += edits;
+  stats.edited = true;
+  update_node_masses(mesh, materials);
+  std::vector<int> nodes = nodes_of_faces(mesh, r.active_faces);
+  for (int n : zone)
+    if (!mesh.nodes[n].dead) nodes.push_back(n);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+// Steps 2c-d: the breaking nodes of the zone at the positions a zone step predicts, positions rewound. When the
+// zone's system cannot be solved the prediction is skipped (the stress at the current positions decides).
+std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
+                               const FractureContext& context, CholeskySolver& solver,
+                               std::vector<FaceFractureStress>& stress, const std::vector<char>& refused,
+                               const SeparationOptions& options) {
+  std::vector<Vec3> saved;
+  std::vector<int> moved;
+  try {
+    const ZoneSolution sol = solve_zone(mesh, materials, zone, context.loads, context.dt, solver);
+    moved = sol.nodes;
+    saved.reserve(moved.size());
+    for (size_t i = 0; i < moved.size(); ++i) {
+      Node& n = mesh.nodes[moved[i]];
+      saved.push_back(n.x);
+      n.x += context.dt * sol.dv[i];
+    }
+  } catch (const NumericalError&) {
+    moved.clear();
+    saved.clear();
+  }
+  update_fracture_stresses(mesh, materials, faces_of_nodes(mesh, zone), stress);
+  std::vector<Candidate> out = breaking_nodes(mesh, materials, zone, stress, refused, options);
+  for (size_t i = 0; i < moved.size(); ++i) mesh.nodes[moved[i]].x = saved[i];
+  return out;
+}
+
+void mark(std::vector<char>& flags, int n) {
+  if (n >= static_cast<int>(flags.size())) flags.resize(n + 1, 0);
+  flags[n] = 1;
+}
+
+// The ablation: one evaluation, every breaking node opened strongest first, no prediction. A node whose fan an
+// earlier opening changed is skipped (its evaluation is stale).
+void open_without_substepping(Mesh& mesh, const std::vector<Material>& materials,
+                              const std::vector<Candidate>& candidates, const FractureParams& params,
+                              const FractureContext& context, FractureStats& stats) {
+  std::vector<char> touched(mesh.nodes.size(), 0);
+  for (const Candidate& c : candidates) {
+    if (stats.cracks >= params.max_cracks) break;
+    const int n = c.separation.node;
+    if (mesh.nodes[n].dead || (n < static_cast<int>(touched.size()) && touched[n])) continue;
+    std::vector<int> fan_nodes = node_rings(mesh, {n}, 1);
+    const CrackOpening opening = open_at(mesh, materials, c, params, context, stats);
+    if (!opening.ok) continue;
+    for (int m : fan_nodes) mark(touched, m);
+    for (int m : opening.nodes) mark(touched, m);
+  }
+}
+
+}  // namespace
+
+FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, const FractureParams& params,
+                            const FractureContext& context, CholeskySolver& zone_solver) {
+  const auto start = std::chrono::steady_clock::now();
+  FractureStats stats;
+  if (!has_fracture(materials) || params.max_cracks <= 0) return stats;
+
+  std::vector<FaceFractureStress> stress = fracture_stresses(mesh, materials);
+  std::vector<char> refused(mesh.nodes.size(), 0);
+  std::vector<Candidate> candidates =
+      breaking_nodes(mesh, materials, live_nodes(mesh), stress, refused, params.separation);
+  stats.candidates = static_cast<int>(candidates.size());
+  if (!candidates.empty()) stats.max_ratio = candidates.front().separation.ratio();
+
+  if (!candidates.empty() && !params.substepping) {
+    open_without_substepping(mesh, materials, candidates, params, context, stats);
+  } else if (!candidates.empty()) {
+    std::vector<int> zone;
+    for (const Candidate& c : candidates) zone.push_back(c.separation.node);
+    const bool remesh_locally = params.local_remesh && size_min_of(context) > 0;
+    // Every iteration opens a crack or refuses a node for the rest of the step: bounded.
+    const int max_iterations = 2 * params.max_cracks + 16;
+    while (!zone.empty() && stats.cracks < params.max_cracks && stats.substeps < max_iterations) {
+      ++stats.substeps;
+      std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
+      if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, stats);
+      stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
+      candidates = predict(mesh, materials, zone_nodes, context, zone_solver, stress, refused, params.separation);
+      if (candidates.empty()) break;
+      const CrackOpening opening = open_at(mesh, materials, candidates.front(), params, context, stats);
+      if (!opening.ok) mark(refused, candidates.front().separation.node);
+      if (stats.edited) update_node_masses(mesh, materials);
+      zone.clear();
+      for (size_t i = 1; i < candidates.size(); ++i) zone.push_back(candidates[i].separation.node);
+      if (opening.ok) zone.insert(zone.end(), opening.tips.begin(), opening.tips.end());
+      zone.erase(std::remove_if(zone.begin(), zone.end(),
+                                [&](int n) {
+                                  return n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead;
+                                }),
+                 zone.end());
+      std::sort(zone.begin(), zone.end());
+      zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+    }
+  }
+  if (stats.edited) update_node_masses(mesh, materials);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace arcsim

@@ -1,0 +1,77 @@
+// Fracture substepping (paper §4.1, Algorithm 1): per physics step and cloth, after plasticity and before the
+// frame-end remesh, every node whose separation strength exceeds its toughness may open a crack; one crack at a
+// time, each decided on a local prediction of the stress after the previous one.
+//
+//   1. sigma+ of every face, s of every node (fracture/fracture_stress.hpp, separation_strength.hpp);
+//      Z = the nodes with s > tau. None: done (the usual case; it costs one stress evaluation).
+//   2. While Z is not empty and fewer than max_cracks openings were made:
+//      a. Z' = Z and its n-ring (n = zone_rings);
+//      b. local remesh of Z''s faces down to size_min (remesh/remesh.hpp with a face subset, uniform metric),
+//         so the crack opens at the finest resolution;
+//      c. virtual physics update of Z' (physics/zone_solve.hpp; a 1-ring support held fixed): one implicit
+//         step of the step's size with the step's gravity and handle springs (no contacts). Only its velocity
+//         change moves the nodes, x + dt dv: that is the stress relaxation the opened cracks cause, not the
+//         step's motion, which the next full step makes;
+//      d. s for Z''s nodes at the predicted positions, then positions rewound;
+//      e. the node with the largest s / tau opens (fracture/crack_opening.hpp, through one edit session):
+//         Z = the nodes of Z' with s > tau, minus the opened node, plus the new crack tips. A refused opening
+//         is logged and that node is not tried again in this step.
+//   At the end the node positions are the step's positions (up to the edit session's local reprojection of
+//   the split nodes, Eq. 13): only the topology changed.
+//
+// Ablations (paper §7, Fig. 5): substepping = false opens every node with s > tau of one evaluation, largest
+// first, with neither local remesh nor virtual update (nodes next to an earlier opening are skipped);
+// reproject = false turns off the crack opening's local reprojection.
+#pragma once
+
+#include <vector>
+
+#include "fracture/crack_opening.hpp"
+#include "fracture/separation_strength.hpp"
+#include "mesh/mesh.hpp"
+#include "physics/block_system.hpp"
+#include "physics/cloth_physics.hpp"
+#include "physics/material.hpp"
+#include "remesh/remesh.hpp"
+
+namespace arcsim {
+
+struct FractureParams {
+  int zone_rings = 3;        // n of Algorithm 1 (at least 2 relieve bending stress, paper §4.1)
+  int max_cracks = 100;      // openings per step and cloth (magic.max_cracks)
+  bool substepping = true;   // Algorithm 1; false: the ablation described above
+  bool local_remesh = true;  // step 2b (needs the remeshing module and a finite size_min)
+  bool reproject = true;     // Eq. 13 after each opening
+  SeparationOptions separation;
+  CrackOpeningOptions opening;  // opening.size_min is taken from remesh.sizing.remeshing.size_min
+};
+
+// What the simulation hands to one fracture pass of a cloth.
+struct FractureContext {
+  RemeshOptions remesh;  // the cloth's remeshing options (sizes, reference, reprojection, world guard)
+  ExternalLoads loads;   // gravity and handle springs at the step's time (contacts are ignored)
+  double dt = 0;         // s
+};
+
+struct FractureStats {
+  int cracks = 0;         // openings made
+  int refused = 0;        // openings refused (mesh left valid)
+  int substeps = 0;       // iterations of Algorithm 1's loop
+  int candidates = 0;     // nodes with s > tau in the first evaluation
+  int largest_zone = 0;   // nodes of the largest Z'
+  int remesh_edits = 0;   // local remeshing edits
+  double max_ratio = 0;   // largest s / tau seen in the first evaluation
+  bool edited = false;    // some topology edit happened (the caller's topology_changed)
+  double seconds = 0;     // wall time
+  FractureStats& operator+=(const FractureStats& o);
+};
+
+// One fracture pass (Algorithm 1) over `mesh`. Leaves tombstones (the caller compacts) and node masses current.
+// `zone_solver` is a solver kept for zone solves (its pattern changes every solve).
+FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, const FractureParams& params,
+                            const FractureContext& context, CholeskySolver& zone_solver);
+
+// Whether any material can break (toughness > 0).
+bool has_fracture(const std::vector<Material>& materials);
+
+}  // namespace arcsim
