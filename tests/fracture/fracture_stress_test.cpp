@@ -18,6 +18,8 @@
 
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
 
 #include "physics/face_element.hpp"
@@ -281,6 +283,24 @@ TEST(FractureStress, SubsetUpdateMatchesTheFullEvaluation) {
   }
   EXPECT_EQ(partial[5].lambda_max, 0);
   EXPECT_GT(full[5].lambda_max, 0);
+}
+
+TEST(FractureStress, SameResultOnAnyThreadCount) {
+  Mesh mesh = sheet(12, 0.3, Diagonal::kAlternating);
+  for (Node& node : mesh.nodes)
+    node.x = Vec3(1.02 * node.x.x(), node.x.y() + 0.01 * node.x.x(), 0.5 * node.x.y() * node.x.y());
+  const std::vector<Material> materials = breakable(0.3, 2);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto serial = fracture_stresses(mesh, materials);
+  omp_set_num_threads(std::max(threads, 3));
+  const auto parallel = fracture_stresses(mesh, materials);
+  omp_set_num_threads(threads);
+  ASSERT_EQ(serial.size(), parallel.size());
+  for (size_t f = 0; f < serial.size(); ++f) {
+    EXPECT_EQ(serial[f].sigma, parallel[f].sigma);
+    EXPECT_EQ(serial[f].lambda_max, parallel[f].lambda_max);
+  }
 }
 
 TEST(FractureStress, ToughnessAndRestSpaceStress) {

@@ -26,6 +26,7 @@
 #include <iostream>
 #include <random>
 
+#include "mesh/edits.hpp"
 #include "support/mesh_factory.hpp"
 
 namespace arcsim {
@@ -243,6 +244,38 @@ TEST(SeparationStrength, CrackTipUnderModeOneCutsStraightAhead) {
     ASSERT_EQ(s.rays.size(), 1u);
     EXPECT_TRUE(ray_in_face(mesh, 0, s.rays[0]));
     EXPECT_GE(s.rays[0].direction.dot(Vec3(ahead.x(), ahead.y(), 0)), std::cos(0.9 * kDegree) - 1e-9);
+  }
+}
+
+// A slit cut into a grid from its left border along the middle row, node by node, as the crack opening does.
+// Returns the tip node (on the border, with a 2 pi wedge).
+int cut_slit(Mesh& mesh, int nx, int row, int length) {
+  auto node = [&](int i) { return row * (nx + 1) + i; };
+  for (int i = 0; i < length; ++i) {
+    const int edge = mesh.find_edge(node(i), node(i + 1));
+    const EditResult r = split_node(mesh, node(i), {edge});
+    if (!r.ok) ADD_FAILURE() << "split_node refused at " << i;
+  }
+  return node(length);
+}
+
+TEST(SeparationStrength, SlitInAGridGrowsStraightAheadUnderModeOne) {
+  for (auto diagonal : {testing::Diagonal::kForward, testing::Diagonal::kAlternating}) {
+    Mesh mesh = testing::make_grid(8, 8, 0.8, 0.8, diagonal);
+    for (Face& f : mesh.faces) f.thickness = kThickness;
+    const int tip = cut_slit(mesh, 8, 4, 4);
+    ASSERT_TRUE(mesh.is_boundary_node(tip));
+    const NodeSeparation s = node_separation(mesh, materials(), tip, uniform_stress(mesh, uniaxial(kSigma, Vec2(0, 1))));
+    EXPECT_TRUE(s.on_boundary);
+    EXPECT_NEAR(s.factor, 2, 1e-6);
+    EXPECT_NEAR(s.strength, kSigma, 0.01 * kSigma);
+    ASSERT_EQ(s.rays.size(), 1u);
+    EXPECT_TRUE(ray_in_face(mesh, tip, s.rays[0]));
+    EXPECT_GE(s.rays[0].direction.x(), std::cos(0.9 * kDegree) - 1e-9);
+    // A node on the slit's lip, loaded the same way, is pulled off the border, not along it: no break.
+    const int lip = 4 * 9 + 2;
+    EXPECT_LT(node_separation(mesh, materials(), lip, uniform_stress(mesh, uniaxial(kSigma, Vec2(0, 1)))).strength,
+              1e-9 * kSigma);
   }
 }
 
