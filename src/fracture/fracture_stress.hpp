@@ -16,6 +16,10 @@
 // glass sphere at rest does not crack) and the plastic curvature (the bending tensor of the edges' plastic
 // angle offsets, rest_theta - rest dihedral, remesh/sizing.hpp's face_bending_tensor). With alpha = 0 the
 // bending term is skipped entirely (F_B = F_el).
+// Sign: II > 0 along a direction in which the sheet bends away from its normal side (the normals spread, as on
+// a sphere with outward normals); dihedral angles (mesh.hpp) are negative where it bends towards it, and the
+// bending tensor of the angles has their sign, so the plastic part cancels the world part of a sheet resting in
+// its plastic shape (tested: fracture_stress_test, PlasticCurvatureIsSubtracted).
 //
 // Units: sigma in N/m (force per unit length of the sheet's mid-surface); divide by h for Pa.
 #pragma once

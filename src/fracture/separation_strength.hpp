@@ -13,15 +13,24 @@
 // smallest common component, so an unbalanced load (rigid motion) does not break.
 //
 // Normalisation (what makes `toughness` a strength in Pa, as in ARCSim, on any fan): for a uniform uniaxial
-// stress sigma n n^T across the split (n the split plane's normal), s = sigma * c, where c depends only on the
-// fan's geometry and the plane: c = 2 for an interior node (the unit disc's diameter), 1 for a straight border
-// with a perpendicular cut, 2 at a crack tip cut straight ahead. The reported strength is s / c, so uniform
-// uniaxial stress sigma breaks every node, interior or border, exactly when sigma > tau: onset does not depend
-// on the mesh. Planes with c below kMinGeometryFactor (a ray grazing a border) are not candidates.
+// stress sigma n n^T across a split (n the normal of its first ray), s = sigma * c(plane), where c depends only
+// on the fan's geometry and the plane: c = 2 at an interior node (the unit disc's diameter), 1 for a straight
+// border with a perpendicular cut, 2 at a crack tip cut straight ahead. The node's factor c is the largest
+// c(plane) over its sampled planes (refined near the best sample), and the reported strength is s / c: uniform
+// uniaxial stress sigma breaks every node, interior or border, exactly when sigma > tau, so onset does not depend
+// on the mesh. (Dividing each plane's s by its own c(plane) instead would reward grazing rays: on a straight
+// border loaded along it, s / c(plane) = sigma sin(phi) / (1 - |cos(phi)|) grows to 2.6 sigma at the grazing
+// limit, and at a crack tip under mode I it is sigma for every ray, so nothing would prefer straight ahead.)
+// Planes with c(plane) below kMinGeometryFactor (a ray grazing a border) and planes whose rays lie in an
+// unbreakable face (toughness 0) are not candidates.
 //
 // Sampling: `samples` angles uniformly over the fan's total angle (200 as in the paper); the per-face arc
-// integrals that do not depend on the angle are precomputed. A node whose faces' largest eigenvalue of sigma+
-// is below half the fan's smallest toughness is skipped (s / c <= 2 max lambda / c can not reach tau there).
+// integrals up to each face are precomputed (prefix sums), so a sample costs two look-ups. Interior planes repeat
+// after half the total angle: the distinct planes are 360/200 = 1.8 deg apart; border rays total/200 apart.
+// Cheap skip (as ARCSim): a node whose faces' largest eigenvalue of sigma+ is below half the fan's smallest
+// toughness is not evaluated. Since s <= lambda_max * (total angle) / 2, this never skips a breaking node when
+// c >= total / 4: flat interior nodes, straight borders, crack tips; it may at sharp convex corners (a 90 deg
+// corner has c = 0.29), where stress is rare.
 #pragma once
 
 #include <vector>
@@ -46,7 +55,7 @@ struct NodeSeparation {
   int node = kNone;
   double strength = 0;     // s / c (N/m), see above; 0 when skipped or no candidate plane
   double raw = 0;          // s of Eq. 7 (N/m) for the best plane
-  double factor = 0;       // c of the best plane (dimensionless)
+  double factor = 0;       // the node's geometric factor c (dimensionless), see above
   double toughness = 0;    // tau (N/m) of the faces the best plane cuts (their mean area toughness)
   bool on_boundary = false;
   std::vector<CutRay> rays;  // the best plane: 2 rays at an interior node, 1 at a border / crack node
