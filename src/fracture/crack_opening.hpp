@@ -12,8 +12,26 @@
 //
 // Mass and linear momentum are conserved exactly (up to round-off): a split edge's new node interpolates the
 // velocity linearly at t, which is what the lumped masses redistribute; a node split copies the velocity.
-// Refused (nothing changes) when the cut would need a face or edge smaller than the sliver limits, follow an
-// edge that is already a border, or leave an invalid mesh; the reason is returned.
+// Refused when the cut would need a face or edge smaller than the sliver limits, follow an edge that is already
+// a border, put both rays on one edge, or the session refuses an edit; the reason is returned. Every check that
+// needs no edit runs on all rays before the first edit, so a refusal normally changes nothing. Only when the
+// session refuses a later step after the first ray's edge split succeeded (or the second ray's plan changes
+// because of that split) does a refused opening leave that split in place: mesh_changed says so, and the mesh
+// is valid (a split edge alone is an ordinary remeshing edit).
+//
+// Snap rule, per ray, in the face it leaves through (rest space):
+//   1. the ray is within snap_angle of one of the face's two edges at the node: follow that edge;
+//   2. else it crosses the opposite edge at t (from the end of the face's edge_out); if t < snap_fraction and
+//      t * |opposite edge| < snap_distance * size_min, follow the edge to that end (likewise 1 - t for the
+//      other end); with size_min = 0 rule 2 never snaps;
+//   3. else split the opposite edge at t, unless an edge of the split is shorter than sliver * size_min or a
+//      child face (either side of the opposite edge) has an area below (sliver * size_min)^2.
+// Unlike ARCSim, a snap never slides the end vertex onto the cut: rest positions only move through the session.
+// A ray's face is a hint: if it is dead, lacks the node or does not hold the direction, the node's face that
+// holds it is used (this also follows a ray into the children of a face split for the other ray).
+//
+// Preserve flags: split_node marks the node, its copies and split far ends preserved; the new tips (far ends
+// that were interior) are not touched: a driver that wants them kept by remeshing marks them itself.
 #pragma once
 
 #include <cmath>
@@ -39,9 +57,12 @@ struct CrackOpening {
   bool ok = false;
   std::string refused;           // why, when !ok
   std::vector<int> crack_edges;  // the edges the crack follows (before the node split)
-  std::vector<int> tips;         // far ends of the crack edges: the new crack tips, candidates next substep
+  std::vector<int> tips;         // far ends of the crack edges that were interior: the new crack tips (now on a
+                                 // crack lip), candidates next substep; far ends already on a border are split
+                                 // with the node instead (the crack reached the border) and are not tips
   std::vector<int> nodes;        // the split node and the copies split_node made
   int edge_splits = 0, snaps = 0;
+  bool mesh_changed = false;     // an edit succeeded (true when ok; see above for when it is true and !ok)
 };
 
 CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay>& rays,

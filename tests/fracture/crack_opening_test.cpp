@@ -1,0 +1,518 @@
+// Crack opening (fracture/crack_opening.hpp): which edges a cut follows (snap or split), that the node splits
+// into sides of the plane, that cracks running tip to tip separate a strip, and randomised sequences of
+// openings mixed with remeshing edits that keep the mesh valid and conserve mass and momentum.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "edit/edit_session.hpp"
+#include "fracture/crack_opening.hpp"
+#include "mesh/mesh_fixtures.hpp"
+#include "mesh/validate.hpp"
+#include "physics/cloth_physics.hpp"
+#include "plasticity/plastic_fixtures.hpp"
+#include "support/mesh_factory.hpp"
+
+namespace arcsim {
+namespace {
+
+using testing::Diagonal;
+using testing::make_grid;
+
+double corner_angle(const Mesh& m, const FanCorner& c) {
+  const Face& f = m.faces[c.face];
+  const Vec3& u = m.verts[f.v[c.corner]].u;
+  const Vec3 out = m.verts[f.v[(c.corner + 1) % 3]].u - u, in = m.verts[f.v[(c.corner + 2) % 3]].u - u;
+  return std::atan2(out.cross(in).norm(), out.dot(in));
+}
+
+// Total rest angle of the node's fan.
+double fan_angle(const Mesh& m, int node) {
+  NodeFan fan;
+  if (!node_fan(m, node, fan)) return 0;
+  double total = 0;
+  for (const FanCorner& c : fan.corners) total += corner_angle(m, c);
+  return total;
+}
+
+// The ray at unfolded angle `angle` (rad, CCW from the fan's first edge_out, in [0, fan_angle)).
+CutRay ray_at(const Mesh& m, int node, double angle) {
+  NodeFan fan;
+  CutRay ray;
+  if (!node_fan(m, node, fan)) return ray;
+  for (const FanCorner& c : fan.corners) {
+    const double corner = corner_angle(m, c);
+    if (angle <= corner || &c == &fan.corners.back()) {
+      const Face& f = m.faces[c.face];
+      const Vec3& u = m.verts[f.v[c.corner]].u;
+      const Vec3 out = (m.verts[f.v[(c.corner + 1) % 3]].u - u).normalized();
+      const double alpha = std::min(angle, corner);
+      ray.face = c.face;
+      ray.direction = std::cos(alpha) * out + std::sin(alpha) * f.rest_normal.cross(out);
+      return ray;
+    }
+    angle -= corner;
+  }
+  return ray;
+}
+
+// The ray from `node` along a rest direction of a flat sheet in the xy plane: the face whose wedge holds it.
+CutRay ray_along(const Mesh& m, int node, const Vec3& direction) {
+  const Vec3 d = direction.normalized();
+  for (int f : m.node_faces(node)) {
+    const int c = m.corner_of_node(f, node);
+    const Face& face = m.faces[f];
+    const Vec3& u = m.verts[face.v[c]].u;
+    const Vec3 out = m.verts[face.v[(c + 1) % 3]].u - u, in = m.verts[face.v[(c + 2) % 3]].u - u;
+    if (out.cross(d).z() >= -1e-12 && d.cross(in).z() >= -1e-12) return CutRay{f, d};
+  }
+  return CutRay{};
+}
+
+Vec3 rest_of(const Mesh& m, int node) { return m.verts[m.nodes[node].verts[0]].u; }
+
+Vec3 rest_centroid(const Mesh& m, int f) {
+  const Face& face = m.faces[f];
+  return (m.verts[face.v[0]].u + m.verts[face.v[1]].u + m.verts[face.v[2]].u) / 3;
+}
+
+struct Sheet {
+  explicit Sheet(Mesh mesh_in) : mesh(std::move(mesh_in)) {
+    for (Face& f : mesh.faces) f.thickness = materials[0].thickness;
+    session = std::make_unique<EditSession>(mesh, materials, EditSessionOptions{});
+  }
+  Mesh mesh;
+  std::vector<Material> materials{testing::aluminium_sheet(1.0)};
+  std::unique_ptr<EditSession> session;
+};
+
+CrackOpeningOptions options_with_size(double size_min) {
+  CrackOpeningOptions o;
+  o.size_min = size_min;
+  return o;
+}
+
+struct Totals {
+  double mass = 0;
+  Vec3 momentum = Vec3::Zero();
+  double momentum_scale = 0;  // sum of m |v|: what round-off of the momentum is relative to
+};
+
+Totals totals(Mesh& m, const std::vector<Material>& materials) {
+  update_node_masses(m, materials);
+  Totals t;
+  for (const Node& n : m.nodes) {
+    if (n.dead) continue;
+    t.mass += n.mass;
+    t.momentum += n.mass * n.v;
+    t.momentum_scale += n.mass * n.v.norm();
+  }
+  return t;
+}
+
+// Every face of each side's node lies on that side of the line through `point` along `along` (rest, xy).
+void expect_sides_separated(const Mesh& m, const CrackOpening& c, const Vec3& point, const Vec3& along) {
+  ASSERT_EQ(c.nodes.size(), 2u);
+  for (int n : c.nodes) {
+    int positive = 0, negative = 0;
+    for (int f : m.node_faces(n)) (along.cross(rest_centroid(m, f) - point).z() > 0 ? positive : negative) += 1;
+    EXPECT_GT(positive + negative, 0) << "node " << n;
+    EXPECT_TRUE(positive == 0 || negative == 0) << "node " << n << " has faces on both sides of the cut";
+  }
+  EXPECT_NE(m.node_faces(c.nodes[0]), m.node_faces(c.nodes[1]));
+}
+
+TEST(CrackOpening, InteriorCutAcrossAGridNodeFollowsTheGridLine) {
+  Sheet s(make_grid(6, 4, 1.2, 0.8, Diagonal::kAlternating));
+  const int node = test::grid_node(6, 3, 2);  // at (0.6, 0.4)
+  const int faces = s.session->live_faces();
+  const std::vector<CutRay> rays{ray_along(s.mesh, node, Vec3(0, 1, 0)), ray_along(s.mesh, node, Vec3(0, -1, 0))};
+  const CrackOpening c = open_crack(*s.session, node, rays, options_with_size(0.2));
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(s.mesh), "");
+  EXPECT_EQ(c.snaps, 2);
+  EXPECT_EQ(c.edge_splits, 0);
+  EXPECT_EQ(s.session->live_faces(), faces);
+  ASSERT_EQ(c.crack_edges.size(), 2u);
+  for (int e : c.crack_edges) {
+    EXPECT_TRUE(s.mesh.edges[e].is_boundary());
+    for (int n : s.mesh.edges[e].n) EXPECT_NEAR(rest_of(s.mesh, n).x(), 0.6, 1e-12);
+  }
+  ASSERT_EQ(c.tips.size(), 2u);
+  for (int tip : c.tips) EXPECT_NEAR(rest_of(s.mesh, tip).x(), 0.6, 1e-12);
+  expect_sides_separated(s.mesh, c, rest_of(s.mesh, node), Vec3(0, 1, 0));
+  EXPECT_TRUE(s.mesh.nodes[c.nodes[0]].preserve && s.mesh.nodes[c.nodes[1]].preserve);
+  EXPECT_EQ(count_components(s.mesh), 1);
+}
+
+TEST(CrackOpening, InteriorCutAtAnAngleSplitsTheOppositeEdgesOnThePlane) {
+  // Forward diagonals: a ray 20 degrees off the vertical leaves through a face whose opposite edge is a row.
+  Sheet s(make_grid(6, 4, 1.2, 0.8, Diagonal::kForward));
+  const int node = test::grid_node(6, 3, 2);
+  const Vec3 along = Vec3(std::sin(0.35), std::cos(0.35), 0);  // 20 degrees from the grid line
+  const Vec3 point = rest_of(s.mesh, node);
+  const std::vector<CutRay> rays{ray_along(s.mesh, node, along), ray_along(s.mesh, node, -along)};
+  const CrackOpening c = open_crack(*s.session, node, rays, options_with_size(0.2));
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(s.mesh), "");
+  EXPECT_EQ(c.edge_splits, 2);
+  EXPECT_EQ(c.snaps, 0);
+  ASSERT_EQ(c.tips.size(), 2u);
+  for (int tip : c.tips) {
+    const Vec3 offset = rest_of(s.mesh, tip) - point;
+    EXPECT_NEAR(along.cross(offset).z(), 0, 1e-12) << "tip off the plane";
+    EXPECT_NEAR(std::abs(offset.y()), 0.2, 1e-12) << "tip not on the next grid row";
+  }
+  expect_sides_separated(s.mesh, c, point, along);
+}
+
+// Border node (3, 0) of a forward-diagonal grid with cells of h = 0.2: its face (a, c, d) of cell (3, 0) spans
+// from the diagonal to the vertical edge; the top edge c-d is opposite. `offset` is where the ray crosses that
+// edge, measured from d = (0.6, 0.2) towards c.
+struct BorderCut {
+  Sheet sheet{make_grid(6, 4, 1.2, 0.8, Diagonal::kForward)};
+  int node = test::grid_node(6, 3, 0);
+  CrackOpening cut(double offset, double size_min) {
+    const CutRay ray = ray_along(sheet.mesh, node, Vec3(offset, 0.2, 0));
+    return open_crack(*sheet.session, node, {ray}, options_with_size(size_min));
+  }
+};
+
+TEST(CrackOpening, BorderNodeFollowsAnEdgeWithinTheSnapAngle) {
+  BorderCut b;
+  const int faces = b.sheet.session->live_faces();
+  const CrackOpening c = b.cut(0.2 * std::tan(3 * M_PI / 180), 0.0);  // 3 degrees off the vertical edge
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(b.sheet.mesh), "");
+  EXPECT_EQ(c.snaps, 1);
+  EXPECT_EQ(c.edge_splits, 0);
+  EXPECT_EQ(b.sheet.session->live_faces(), faces);
+  ASSERT_EQ(c.tips.size(), 1u);
+  EXPECT_EQ(c.tips[0], test::grid_node(6, 3, 1));
+  expect_sides_separated(b.sheet.mesh, c, rest_of(b.sheet.mesh, b.node), Vec3(0, 1, 0));
+}
+
+TEST(CrackOpening, BorderNodeSnapsToAVertexCloseToTheCrossing) {
+  // Crossing 0.15 h from d: 8.5 degrees off the edge, fraction 0.15 < 0.2, 0.03 m < 0.1 * size_min = 0.04 m.
+  BorderCut b;
+  const int faces = b.sheet.session->live_faces();
+  const CrackOpening c = b.cut(0.03, 0.4);
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(b.sheet.mesh), "");
+  EXPECT_EQ(c.snaps, 1);
+  EXPECT_EQ(c.edge_splits, 0);
+  EXPECT_EQ(b.sheet.session->live_faces(), faces) << "a snap makes no sliver faces";
+  ASSERT_EQ(c.tips.size(), 1u);
+  EXPECT_EQ(c.tips[0], test::grid_node(6, 3, 1));
+}
+
+TEST(CrackOpening, BorderNodeSplitsWhenTheCrossingIsFartherThanTheSnapDistance) {
+  // Same crossing, size_min 0.2 m: 0.03 m > 0.1 * size_min, so the top edge is split at the crossing.
+  BorderCut b;
+  const int faces = b.sheet.session->live_faces();
+  const CrackOpening c = b.cut(0.03, 0.2);
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(b.sheet.mesh), "");
+  EXPECT_EQ(c.edge_splits, 1);
+  EXPECT_EQ(c.snaps, 0);
+  EXPECT_EQ(b.sheet.session->live_faces(), faces + 2);  // the top edge's two faces, halved
+  ASSERT_EQ(c.tips.size(), 1u);
+  EXPECT_NEAR((rest_of(b.sheet.mesh, c.tips[0]) - Vec3(0.63, 0.2, 0)).norm(), 0, 1e-12);
+  expect_sides_separated(b.sheet.mesh, c, rest_of(b.sheet.mesh, b.node), Vec3(0.03, 0.2, 0));
+}
+
+TEST(CrackOpening, BorderNodeSplitsWhenTheCrossingIsBeyondTheSnapFraction) {
+  // Crossing 0.25 h from d: within the snap distance of a large size_min (0.05 m < 0.08 m) but not the fraction.
+  BorderCut b;
+  const CrackOpening c = b.cut(0.05, 0.8);
+  ASSERT_TRUE(c.ok) << c.refused;
+  EXPECT_EQ(check_mesh(b.sheet.mesh), "");
+  EXPECT_EQ(c.edge_splits, 1);
+  ASSERT_EQ(c.tips.size(), 1u);
+  EXPECT_NEAR((rest_of(b.sheet.mesh, c.tips[0]) - Vec3(0.65, 0.2, 0)).norm(), 0, 1e-12);
+}
+
+TEST(CrackOpening, RefusedCutsLeaveTheMeshUntouched) {
+  BorderCut b;
+  const Mesh& m = b.sheet.mesh;
+  const uint64_t before = test::fingerprint(m);
+  // A split at the middle of the top edge with size_min 2.4 m: edges of 0.1 m < sliver * size_min = 0.12 m.
+  CrackOpening c = b.cut(0.1, 2.4);
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.refused.find("sliver"), std::string::npos) << c.refused;
+  // Along the border edge.
+  c = open_crack(*b.sheet.session, b.node, {ray_along(m, b.node, Vec3(1, 0, 0))}, options_with_size(0.2));
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.refused.find("border"), std::string::npos) << c.refused;
+  // Both rays of an interior node onto one edge (2 degrees either side of the vertical edge).
+  const int interior = test::grid_node(6, 3, 2);
+  const double tilt = std::tan(2 * M_PI / 180);
+  c = open_crack(*b.sheet.session, interior,
+                 {ray_along(m, interior, Vec3(tilt, 1, 0)), ray_along(m, interior, Vec3(-tilt, 1, 0))},
+                 options_with_size(0.2));
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.refused.find("same edge"), std::string::npos) << c.refused;
+  // One ray at an interior node.
+  c = open_crack(*b.sheet.session, interior, {ray_along(m, interior, Vec3(0, 1, 0))}, options_with_size(0.2));
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(test::fingerprint(m), before);
+  EXPECT_FALSE(b.sheet.session->edited());
+  EXPECT_EQ(check_mesh(m), "");
+}
+
+// A narrow fan at border node N: the rays cross edges a-b and a-x, both 0.3 m from the inner node a. Planned on
+// the mesh as it is, both splits are fine; once a-b is split at p, the far side of a-x is the thin face a-p-x
+// and its split at q would make an edge p-q of 0.1 m < sliver * size_min = 0.125 m.
+TEST(CrackOpening, SecondRayRefusedAfterTheFirstSplitReportsTheChange) {
+  const Vec3 N(0, -2, 0), a(0, 0.2, 0), b(0.3, 2, 0), x(-0.3, 2, 0);
+  const std::vector<Vec3> points{N, a, b, x};
+  Sheet s(Mesh::from_triangles(points, points, {0, 1, 2, 3}, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}}));
+  ASSERT_EQ(check_mesh(s.mesh), "");
+  const Vec3 p = a + 0.3 * (b - a).normalized(), q = a + 0.3 * (x - a).normalized();
+  CrackOpeningOptions o = options_with_size(2.5);
+  o.snap_angle = 0.1 * M_PI / 180;
+  const Totals before = totals(s.mesh, s.materials);
+  const CrackOpening c = open_crack(*s.session, 0, {ray_along(s.mesh, 0, p - N), ray_along(s.mesh, 0, q - N)}, o);
+  EXPECT_FALSE(c.ok);
+  EXPECT_TRUE(c.mesh_changed);
+  EXPECT_EQ(c.edge_splits, 1);
+  EXPECT_NE(c.refused.find("sliver"), std::string::npos) << c.refused;
+  EXPECT_NE(c.refused.find("mesh changed"), std::string::npos) << c.refused;
+  EXPECT_EQ(check_mesh(s.mesh), "");
+  EXPECT_EQ(s.session->live_faces(), 5);
+  EXPECT_EQ(s.session->counts().node_splits, 0);
+  EXPECT_NEAR(totals(s.mesh, s.materials).mass, before.mass, 1e-12 * before.mass);
+}
+
+TEST(CrackOpening, RepeatedOpeningsFromTipToTipSeparateAStrip) {
+  Sheet s(make_grid(8, 4, 1.6, 0.8, Diagonal::kAlternating));
+  const Vec3 along(0.3, 1, 0);  // off the grid lines: most steps split an edge
+  int node = test::grid_node(8, 4, 0);
+  std::vector<CutRay> rays{ray_along(s.mesh, node, along)};
+  int openings = 0, splits = 0;
+  for (; openings < 20; ++openings) {
+    const CrackOpening c = open_crack(*s.session, node, rays, options_with_size(0.2));
+    ASSERT_TRUE(c.ok) << "opening " << openings << ": " << c.refused;
+    ASSERT_EQ(check_mesh(s.mesh), "") << "opening " << openings;
+    splits += c.edge_splits;
+    if (c.tips.empty()) break;
+    EXPECT_EQ(count_components(s.mesh), 1) << "opening " << openings;
+    ASSERT_EQ(c.tips.size(), 1u);
+    node = c.tips[0];
+    rays = {ray_along(s.mesh, node, along)};
+    ASSERT_NE(rays[0].face, kNone);
+  }
+  EXPECT_GE(openings, 3);
+  EXPECT_GE(splits, 1);
+  EXPECT_EQ(count_components(s.mesh), 2) << "the crack reached the far border after " << openings + 1 << " openings";
+}
+
+// --- randomised ----------------------------------------------------------------------------------------------
+
+// A grid, an irregular (jittered) grid or an equilateral strip, with random velocities.
+Mesh random_sheet(int kind, std::mt19937& rng) {
+  std::uniform_real_distribution<double> sym(-1, 1);
+  Mesh m = kind == 0 ? make_grid(10, 6, 1.0, 0.6, Diagonal::kAlternating)
+           : kind == 1 ? make_grid(9, 7, 0.9, 0.7, Diagonal::kForward)
+                       : testing::make_equilateral_strip(1.0, 0.5, 0.1, (rng() & 1) != 0);
+  if (kind == 1) {
+    for (size_t n = 0; n < m.nodes.size(); ++n) {
+      if (m.is_boundary_node(static_cast<int>(n))) continue;
+      const Vec3 jitter(0.03 * sym(rng), 0.03 * sym(rng), 0);
+      m.nodes[n].x += jitter;
+      for (int v : m.nodes[n].verts) m.verts[v].u += jitter;
+    }
+    m.update_rest_data();
+  }
+  for (Node& n : m.nodes) {
+    n.x0 = n.x;
+    n.v = Vec3(sym(rng), sym(rng), sym(rng));
+  }
+  return m;
+}
+
+int random_live(const std::vector<Node>& nodes, std::mt19937& rng) {
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(nodes.size()) - 1);
+  for (int tries = 0; tries < 1000; ++tries) {
+    const int i = pick(rng);
+    if (!nodes[i].dead) return i;
+  }
+  return kNone;
+}
+
+int random_live_edge(const Mesh& m, std::mt19937& rng) {
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(m.edges.size()) - 1);
+  for (int tries = 0; tries < 1000; ++tries) {
+    const int i = pick(rng);
+    if (!m.edges[i].dead) return i;
+  }
+  return kNone;
+}
+
+// Random rays at a node: one into the material at a border node, a full plane at an interior one.
+std::vector<CutRay> random_rays(const Mesh& m, int node, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double total = fan_angle(m, node);
+  if (m.is_boundary_node(node)) return {ray_at(m, node, total * (0.02 + 0.96 * unit(rng)))};
+  const double phi = total * unit(rng);
+  return {ray_at(m, node, phi), ray_at(m, node, std::fmod(phi + total / 2, total))};
+}
+
+struct RandomCounts {
+  int attempts = 0, opened = 0, refused = 0, refused_after_split = 0, edge_splits = 0, snaps = 0;
+  int from_tips = 0, separations = 0, max_components = 1, remesh_edits = 0;
+  std::map<std::string, int> reasons;  // of refusals
+};
+
+class RandomRun {
+ public:
+  RandomRun(unsigned seed, RandomCounts& counts) : rng_(seed), c_(counts) {}
+
+  void episode(int kind, int steps) {
+    mesh_ = random_sheet(kind, rng_);
+    for (Face& f : mesh_.faces) f.thickness = materials_[0].thickness * (1 + 0.5 * unit_(rng_));
+    tips_.clear();
+    session_ = std::make_unique<EditSession>(mesh_, materials_, EditSessionOptions{});
+    for (step_ = 0; step_ < steps && !::testing::Test::HasFailure(); ++step_) {
+      if (unit_(rng_) < 0.8)
+        opening();
+      else
+        remesh_edit();
+      if (step_ % 50 == 49) compact();
+    }
+  }
+
+ private:
+  std::string where() const {
+    std::ostringstream s;
+    s << "step " << step_ << " of an episode (attempt " << c_.attempts << ")";
+    return s.str();
+  }
+
+  int pick_node() {
+    if (!tips_.empty() && unit_(rng_) < 0.4) {
+      const size_t k = std::uniform_int_distribution<size_t>(0, tips_.size() - 1)(rng_);
+      const int tip = tips_[k];
+      tips_.erase(tips_.begin() + static_cast<long>(k));
+      if (tip != kNone && !mesh_.nodes[tip].dead) {
+        ++c_.from_tips;
+        return tip;
+      }
+    }
+    return random_live(mesh_.nodes, rng_);
+  }
+
+  void opening() {
+    const int node = pick_node();
+    if (node == kNone || mesh_.node_faces(node).empty()) return;
+    const std::vector<CutRay> rays = random_rays(mesh_, node, rng_);
+    const Totals before = totals(mesh_, materials_);
+    const uint64_t print = test::fingerprint(mesh_);
+    const int components = count_components(mesh_);
+    CrackOpeningOptions options;
+    options.size_min = 0.1 * std::exp(std::uniform_real_distribution<double>(-1, 1)(rng_));
+    ++c_.attempts;
+    const CrackOpening c = open_crack(*session_, node, rays, options);
+    if (!c.ok) {
+      ++c_.refused;
+      ++c_.reasons[c.refused];
+      if (!c.mesh_changed) {
+        ASSERT_EQ(test::fingerprint(mesh_), print) << where() << ": refused opening (" << c.refused << ") changed the mesh";
+        return;
+      }
+      ++c_.refused_after_split;
+    } else {
+      ++c_.opened;
+      c_.edge_splits += c.edge_splits;
+      c_.snaps += c.snaps;
+      tips_.insert(tips_.end(), c.tips.begin(), c.tips.end());
+    }
+    ASSERT_EQ(check_mesh(mesh_), "") << where();
+    const Totals after = totals(mesh_, materials_);
+    ASSERT_NEAR(after.mass, before.mass, 1e-12 * before.mass) << where();
+    ASSERT_LE((after.momentum - before.momentum).norm(), 1e-12 * before.momentum_scale) << where();
+    const int now = count_components(mesh_);
+    c_.separations += now > components;
+    c_.max_components = std::max(c_.max_components, now);
+  }
+
+  void remesh_edit() {
+    const int e = random_live_edge(mesh_, rng_);
+    if (e == kNone) return;
+    const double dice = unit_(rng_);
+    EditResult r;
+    if (dice < 0.4 && session_->live_faces() < 400)
+      r = session_->split_edge(e, 0.2 + 0.6 * unit_(rng_));
+    else if (dice < 0.7)
+      r = session_->flip_edge(e);
+    else if (session_->live_faces() > 60)
+      r = session_->collapse_edge(e, unit_(rng_) < 0.5 ? 0 : 1);
+    if (!r.ok) return;
+    ++c_.remesh_edits;
+    ASSERT_EQ(check_mesh(mesh_), "") << where() << ": remeshing edit";
+  }
+
+  // Compaction renumbers everything: tips follow the map, the next edits get a new session.
+  void compact() {
+    session_.reset();
+    const Mesh::Compaction map = mesh_.compact();
+    for (int& tip : tips_) tip = tip == kNone ? kNone : map.node[tip];
+    ASSERT_EQ(check_mesh(mesh_), "") << where() << ": compact";
+    session_ = std::make_unique<EditSession>(mesh_, materials_, EditSessionOptions{});
+  }
+
+  std::mt19937 rng_;
+  std::uniform_real_distribution<double> unit_{0, 1};
+  RandomCounts& c_;
+  Mesh mesh_;
+  std::vector<Material> materials_{testing::aluminium_sheet(1.0)};
+  std::unique_ptr<EditSession> session_;
+  std::vector<int> tips_;
+  int step_ = 0;
+};
+
+RandomCounts run_random(const std::vector<unsigned>& seeds, int episodes, int steps) {
+  RandomCounts counts;
+  for (unsigned seed : seeds) {
+    RandomRun run(seed, counts);
+    for (int k = 0; k < episodes && !::testing::Test::HasFailure(); ++k) run.episode(k % 3, steps);
+  }
+  return counts;
+}
+
+void expect_varied(const RandomCounts& c, int min_attempts) {
+  EXPECT_GE(c.attempts, min_attempts);
+  EXPECT_GE(c.opened, min_attempts / 3);
+  EXPECT_GT(c.refused, 0);
+  EXPECT_GE(c.edge_splits, 100);
+  EXPECT_GE(c.snaps, 100);
+  EXPECT_GE(c.from_tips, 100);
+  EXPECT_GE(c.remesh_edits, 100);
+  EXPECT_GE(c.separations, 10) << "cracks joining into separate pieces";
+  EXPECT_GT(c.max_components, 1);
+}
+
+TEST(CrackOpeningRandom, OpeningsMixedWithRemeshingKeepTheMeshValidAndConserveMassAndMomentum) {
+  const RandomCounts c = run_random({1u, 2u}, 6, 250);
+  expect_varied(c, 2000);
+  std::cout << "openings " << c.opened << " / " << c.attempts << ", refused " << c.refused << " ("
+            << c.refused_after_split << " after a split), edge splits " << c.edge_splits << ", snaps " << c.snaps
+            << ", from tips " << c.from_tips << ", separations " << c.separations << ", max pieces "
+            << c.max_components << ", remeshing edits " << c.remesh_edits << "\n";
+  for (const auto& [reason, count] : c.reasons) std::cout << "  refused " << count << "x: " << reason << "\n";
+}
+
+TEST(CrackOpeningRandom, SlowCheckManySeeds) {
+  const RandomCounts c = run_random({3u, 4u, 5u, 6u, 7u, 8u, 9u, 10u}, 9, 300);
+  expect_varied(c, 12000);
+}
+
+}  // namespace
+}  // namespace arcsim
