@@ -424,6 +424,16 @@ bool EditSession::reproject(int node) {
   return reproject_unchecked(node);
 }
 
+bool EditSession::move_node(int node, const Vec3& displacement) {
+  Node& n = m_.nodes[node];
+  const Vec3 x = n.x, x0 = n.x0;
+  std::vector<GuardTriangle> before;
+  if (guard_) before = guard_->fan(node);
+  n.x += displacement;
+  n.x0 += displacement;
+  return keep_move(node, before, x, x0);
+}
+
 bool EditSession::reproject_unchecked(int node) {
   const Vec3 x = m_.nodes[node].x, x0 = m_.nodes[node].x0;
   std::vector<GuardTriangle> before;

@@ -118,6 +118,10 @@ class EditSession {
   // (handles, crack tips) stay where they are.
   bool reproject(int node);
 
+  // Moves a node (and its start-of-step position x0) by `displacement` (m) through the world guard; true if
+  // the move was kept. For small moves an edit needs (fracture: the lips of a new crack set apart).
+  bool move_node(int node, const Vec3& displacement);
+
   void add_observer(EditObserver* observer) { observers_.push_back(observer); }
 
   // Zone: a face is in it if it was given, or is a child of a zone face (split children inherit their parent's

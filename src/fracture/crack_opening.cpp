@@ -183,6 +183,24 @@ bool apply_plan(EditSession& session, int node, const RayPlan& plan, CrackOpenin
   return true;
 }
 
+// Moves a node of a new crack by `distance` (m) towards the centroid of its own faces, within its faces' mean
+// world plane.
+void set_lip_apart(EditSession& session, int node, double distance) {
+  const Mesh& m = session.mesh();
+  Vec3 centroid = Vec3::Zero(), normal = Vec3::Zero();
+  const std::vector<int> faces = m.node_faces(node);
+  if (faces.empty()) return;
+  for (int f : faces) {
+    for (int i = 0; i < 3; ++i) centroid += m.nodes[m.face_node(f, i)].x / 3;
+    normal += m.world_normal(f);
+  }
+  centroid /= static_cast<double>(faces.size());
+  Vec3 d = centroid - m.nodes[node].x;
+  if (normal.norm() > 0) d -= d.dot(normal.normalized()) * normal.normalized();
+  if (!(d.norm() > 0)) return;
+  session.move_node(node, distance * d.normalized());
+}
+
 }  // namespace
 
 CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay>& rays,
@@ -227,6 +245,8 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
   for (size_t k = 0; k < copies && k < r.added_nodes.size(); ++k) out.nodes.push_back(r.added_nodes[k]);
   out.tips = tips;
   out.ok = true;
+  if (options.lip_gap > 0)
+    for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap);
   return out;
 }
 

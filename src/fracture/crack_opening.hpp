@@ -49,6 +49,10 @@ struct CrackOpeningOptions {
   double snap_angle = 5 * M_PI / 180;  // rad: a ray this close to an existing edge follows that edge
   double snap_fraction = 0.2;     // a crossing within this fraction of the opposite edge from an end snaps...
   double snap_distance = 0.1;     // ...if it is also within this many size_min of that end (rest space)
+  // The lips of a new crack start this far apart (m; each side moves half of it, in the sheet's plane, away
+  // from the crack): coincident lips have no defined contact normal, so collision handling could not keep
+  // them apart. 0: the lips start coincident.
+  double lip_gap = 2e-6;
   double sliver = 0.05;           // refused: an edge shorter than sliver * size_min, a face of area below
                                   // (sliver * size_min)^2
 };
