@@ -294,7 +294,7 @@ const std::vector<BadCase>& bad_cases() {
       {"max_cracks_fraction", [](Json::Value& j) { j["magic"]["max_cracks"] = 2.5; }, "magic.max_cracks",
        "integer"},
       {"zone_rings_zero", [](Json::Value& j) { j["fracture"]["zone_rings"] = 0; }, "fracture.zone_rings",
-       "must be >= 1"},
+       "must be in [1, 20], got 0"},
       {"zone_rings_nan", [](Json::Value& j) { j["fracture"]["zone_rings"] = std::nan(""); }, "fracture.zone_rings",
        ""},
       {"fracture_substepping_not_bool", [](Json::Value& j) { j["fracture"]["substepping"] = "yes"; },
