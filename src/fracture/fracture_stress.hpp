@@ -32,11 +32,6 @@
 
 namespace arcsim {
 
-// World vertex normals of every node (area-weighted unit face normals; zero for dead nodes), and the same for
-// rest space per vert (indexed like mesh.verts).
-std::vector<Vec3> world_node_normals(const Mesh& mesh);
-std::vector<Vec3> rest_vert_normals(const Mesh& mesh);
-
 // Elastic second fundamental form (1/m, 2x2 symmetric, face material frame) of face f, before the eigenvalue
 // reversal: world part minus rest part minus plastic part (see above).
 Mat2 face_elastic_curvature(const Mesh& mesh, int f, const std::vector<Vec3>& node_normals,

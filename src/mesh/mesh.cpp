@@ -311,4 +311,40 @@ double Mesh::world_area(int f) const {
   return 0.5 * (nodes[face_node(f, 1)].x - x0).cross(nodes[face_node(f, 2)].x - x0).norm();
 }
 
+namespace {
+
+std::vector<Vec3> normalized(std::vector<Vec3> sums) {
+  for (Vec3& n : sums) {
+    const double len = n.norm();
+    n = len > 0 ? Vec3(n / len) : Vec3::Zero();
+  }
+  return sums;
+}
+
+}  // namespace
+
+std::vector<Vec3> world_node_normals(const Mesh& mesh) {
+  std::vector<Vec3> sums(mesh.nodes.size(), Vec3::Zero());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (mesh.faces[f].dead) continue;
+    const int fi = static_cast<int>(f);
+    const Vec3& x0 = mesh.nodes[mesh.face_node(fi, 0)].x;
+    // Twice the area times the unit normal: area weighting for free.
+    const Vec3 weighted = (mesh.nodes[mesh.face_node(fi, 1)].x - x0).cross(mesh.nodes[mesh.face_node(fi, 2)].x - x0);
+    for (int i = 0; i < 3; ++i) sums[mesh.face_node(fi, i)] += weighted;
+  }
+  return normalized(std::move(sums));
+}
+
+std::vector<Vec3> rest_vert_normals(const Mesh& mesh) {
+  std::vector<Vec3> sums(mesh.verts.size(), Vec3::Zero());
+  for (const Face& face : mesh.faces) {
+    if (face.dead) continue;
+    const Vec3& u0 = mesh.verts[face.v[0]].u;
+    const Vec3 weighted = (mesh.verts[face.v[1]].u - u0).cross(mesh.verts[face.v[2]].u - u0);
+    for (int v : face.v) sums[v] += weighted;
+  }
+  return normalized(std::move(sums));
+}
+
 }  // namespace arcsim

@@ -141,4 +141,9 @@ class Mesh {
 // normals. 0 when flat; the sign says which way the sheet folds, consistently in rest and world space.
 double dihedral_angle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3);
 
+// World vertex normals of every node (area-weighted unit face normals; zero for dead nodes), and the same for
+// rest space per vert (indexed like mesh.verts).
+std::vector<Vec3> world_node_normals(const Mesh& mesh);
+std::vector<Vec3> rest_vert_normals(const Mesh& mesh);
+
 }  // namespace arcsim

@@ -273,6 +273,7 @@ void Simulation::advance_step() {
   const double dt = current_step_time();
   time_ += dt;
   ++step_;
+  jitter_step();
   move_obstacles(time_);
 
   // Proximity forces enter the implicit solve; the impact-zone response follows the position update.
@@ -329,6 +330,35 @@ void Simulation::audit(double StepEnergies::*phase, bool fresh_elements) {
       step_energies[c].*phase = mechanical_energy(cloth.mesh, rebuilt, loads);
     } else {
       step_energies[c].*phase = mechanical_energy(cloth.mesh, cloth.elements, loads);
+    }
+  }
+}
+
+namespace {
+
+// splitmix64: a counter-based generator, so a node's jitter depends only on (step, node) and resume replays it.
+uint64_t mix_bits(uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+// ARCSim's add_jitter: during frames 0, 10, ..., 90 every node moves along its normal by a random amount in
+// [0, 1e-4) m. A perfectly flat sheet under compression has no reason to buckle one way or the other; the
+// jitter gives it one, as real paper's waviness does.
+void Simulation::jitter_step() {
+  constexpr double kJitterAmplitude = 1e-4;  // m
+  if (!scene_.magic.add_jitter || frame_ % 10 != 0 || frame_ >= 100) return;
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    Mesh& mesh = cloths[c].mesh;
+    const std::vector<Vec3> normals = world_node_normals(mesh);
+    for (size_t n = 0; n < mesh.nodes.size(); ++n) {
+      const uint64_t bits = mix_bits(mix_bits(mix_bits(static_cast<uint64_t>(step_)) ^ c) ^ n);
+      const double unit = static_cast<double>(bits >> 11) * 0x1.0p-53;  // uniform in [0, 1)
+      mesh.nodes[n].x += kJitterAmplitude * unit * normals[n];
     }
   }
 }

@@ -154,6 +154,7 @@ class Simulation {
   void physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts);
   void collision_step(double dt);
   // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
+  void jitter_step();
   void plasticity_step(double dt);
   // Fracture substepping of every breakable cloth (module "fracture", fracture/fracture_step.hpp), then the
   // follow-up of topology_changed.
