@@ -424,14 +424,16 @@ bool EditSession::reproject(int node) {
   return reproject_unchecked(node);
 }
 
-bool EditSession::move_node(int node, const Vec3& displacement) {
+bool EditSession::move_node(int node, const Vec3& displacement) { return move_node(node, displacement, {}); }
+
+bool EditSession::move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces) {
   Node& n = m_.nodes[node];
   const Vec3 x = n.x, x0 = n.x0;
   std::vector<GuardTriangle> before;
   if (guard_) before = guard_->fan(node);
   n.x += displacement;
   n.x0 += displacement;
-  return keep_move(node, before, x, x0);
+  return keep_move(node, before, x, x0, exempt_faces);
 }
 
 bool EditSession::reproject_unchecked(int node) {
@@ -446,9 +448,10 @@ bool EditSession::reproject_unchecked(int node) {
 
 // After `node` moved from (x, x0), where its faces were `before`: keeps the move if the guard allows it (and
 // indexes the moved faces), else puts the node back. True if the move stays.
-bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0) {
+bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
+                            const std::vector<int>& exempt_faces) {
   if (!guard_) return true;
-  if (m_.nodes[node].x != x && !guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), {})) {
+  if (m_.nodes[node].x != x && !guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), exempt_faces)) {
     m_.nodes[node].x = x;
     m_.nodes[node].x0 = x0;
     ++counts_.guarded;

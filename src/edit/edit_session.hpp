@@ -121,6 +121,9 @@ class EditSession {
   // Moves a node (and its start-of-step position x0) by `displacement` (m) through the world guard; true if
   // the move was kept. For small moves an edit needs (fracture: the lips of a new crack set apart).
   bool move_node(int node, const Vec3& displacement);
+  // The same, but the guard does not check the move against `exempt_faces` (a crack's lips, which start
+  // coincident: any move of one lip touches the other).
+  bool move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces);
 
   void add_observer(EditObserver* observer) { observers_.push_back(observer); }
 
@@ -158,7 +161,8 @@ class EditSession {
   // kReprojection: `node` even if preserved (split_node marks every node it splits preserved).
   bool reproject_unchecked(int node);
   // kGuardMoves
-  bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0);
+  bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
+                 const std::vector<int>& exempt_faces = {});
   GuardTriangle world_triangle(std::array<int, 3> nodes) const;
   GuardTriangle face_triangle(int f) const;
 

@@ -183,22 +183,32 @@ bool apply_plan(EditSession& session, int node, const RayPlan& plan, CrackOpenin
   return true;
 }
 
-// Moves a node of a new crack by `distance` (m) towards the centroid of its own faces, within its faces' mean
-// world plane.
-void set_lip_apart(EditSession& session, int node, double distance) {
+// Moves a node of a new crack by `distance` (m) away from the other side(s) of the split, `twins` (the split
+// node and its copies): along its own faces' centroid minus the centroid of all the copies' faces, within its
+// faces' mean world plane. The guard does not check the move against the twins' faces, which it touches by
+// construction.
+void set_lip_apart(EditSession& session, int node, double distance, const std::vector<int>& twins) {
   const Mesh& m = session.mesh();
-  Vec3 centroid = Vec3::Zero(), normal = Vec3::Zero();
-  const std::vector<int> faces = m.node_faces(node);
-  if (faces.empty()) return;
-  for (int f : faces) {
-    for (int i = 0; i < 3; ++i) centroid += m.nodes[m.face_node(f, i)].x / 3;
-    normal += m.world_normal(f);
+  auto centroid_of = [&](const std::vector<int>& faces) {
+    Vec3 c = Vec3::Zero();
+    for (int f : faces)
+      for (int i = 0; i < 3; ++i) c += m.nodes[m.face_node(f, i)].x / 3;
+    return Vec3(c / static_cast<double>(faces.size()));
+  };
+  const std::vector<int> own = m.node_faces(node);
+  std::vector<int> all, exempt;
+  for (int t : twins) {
+    const std::vector<int> faces = m.node_faces(t);
+    all.insert(all.end(), faces.begin(), faces.end());
+    if (t != node) exempt.insert(exempt.end(), faces.begin(), faces.end());
   }
-  centroid /= static_cast<double>(faces.size());
-  Vec3 d = centroid - m.nodes[node].x;
+  if (own.empty() || all.empty()) return;
+  Vec3 normal = Vec3::Zero();
+  for (int f : own) normal += m.world_normal(f);
+  Vec3 d = centroid_of(own) - centroid_of(all);
   if (normal.norm() > 0) d -= d.dot(normal.normalized()) * normal.normalized();
   if (!(d.norm() > 0)) return;
-  session.move_node(node, distance * d.normalized());
+  session.move_node(node, distance * d.normalized(), exempt);
 }
 
 }  // namespace
@@ -246,7 +256,7 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
   out.tips = tips;
   out.ok = true;
   if (options.lip_gap > 0)
-    for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap);
+    for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap, out.nodes);
   return out;
 }
 

@@ -154,6 +154,15 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
                                const SeparationOptions& options) {
   std::vector<Vec3> saved;
   std::vector<int> moved;
+  // The prediction starts from rest: with the nodes' velocities in it, x + dt dv would also carry -dt v (the
+  // stiff limit of dv is -v plus the relaxation), an error of the order of the step's own motion. The zone and
+  // everything its elements read (support and bending wings, two rings) are held at v = 0 for the solve.
+  const std::vector<int> still = node_rings(mesh, zone, 3);
+  std::vector<Vec3> velocities(still.size());
+  for (size_t i = 0; i < still.size(); ++i) {
+    velocities[i] = mesh.nodes[still[i]].v;
+    mesh.nodes[still[i]].v = Vec3::Zero();
+  }
   try {
     const ZoneSolution sol = solve_zone(mesh, materials, zone, context.loads, context.dt, solver);
     moved = sol.nodes;
@@ -167,6 +176,7 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
     moved.clear();
     saved.clear();
   }
+  for (size_t i = 0; i < still.size(); ++i) mesh.nodes[still[i]].v = velocities[i];
   update_fracture_stresses(mesh, materials, faces_of_nodes(mesh, zone), stress);
   std::vector<Candidate> out = breaking_nodes(mesh, materials, zone, stress, refused, options);
   for (size_t i = 0; i < moved.size(); ++i) mesh.nodes[moved[i]].x = saved[i];

@@ -9,9 +9,11 @@
 //      b. local remesh of Z''s faces down to size_min (remesh/remesh.hpp with a face subset, uniform metric),
 //         so the crack opens at the finest resolution;
 //      c. virtual physics update of Z' (physics/zone_solve.hpp; a 1-ring support held fixed): one implicit
-//         step of the step's size with the step's gravity and handle springs (no contacts). Only its velocity
-//         change moves the nodes, x + dt dv: that is the stress relaxation the opened cracks cause, not the
-//         step's motion, which the next full step makes;
+//         step of the step's size with the step's gravity and handle springs (no contacts), started from
+//         rest (v = 0 in the zone and its support); the nodes move by x + dt dv: that is the stress
+//         relaxation the opened cracks cause, not the step's motion, which the next full step makes (with the
+//         velocities in, dv would also carry -v in the stiff limit: measured on paper-tearing.json, predicted
+//         principal stresses at the notch turned by 60 degrees and tripled);
 //      d. s for Z''s nodes at the predicted positions, then positions rewound;
 //      e. the node with the largest s / tau opens (fracture/crack_opening.hpp, through one edit session):
 //         Z = the nodes of Z' with s > tau, minus the opened node, plus the new crack tips. A refused opening

@@ -42,6 +42,13 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   fracture.local_remesh = scene.fracture.local_remesh;
   fracture.reproject = scene.fracture.reproject;
   fracture.max_cracks = scene.magic.max_cracks;
+  // New lips start apart by twice the projection thickness: closer, they would count as touching (an in-plane
+  // contact with no room to resolve it) from their first step on.
+  {
+    const double projection = scene.magic.projection_thickness >= 0 ? scene.magic.projection_thickness
+                                                                     : 0.1 * scene.magic.repulsion_thickness;
+    fracture.opening.lip_gap = std::max(fracture.opening.lip_gap, 2 * projection);
+  }
   for (Motion& m : motions_) m.finalize();
   for (size_t i = 0; i < scene.cloths.size(); ++i) load_cloth(scene.cloths[i], static_cast<int>(i));
   for (size_t i = 0; i < scene.obstacles.size(); ++i) load_obstacle(scene.obstacles[i], static_cast<int>(i));

@@ -152,6 +152,34 @@ TEST(CrackOpening, InteriorCutAcrossAGridNodeFollowsTheGridLine) {
   EXPECT_EQ(count_components(s.mesh), 1);
 }
 
+// The lips start lip_gap apart in the sheet's plane even with the world guard on: the two copies of a split
+// node are coincident, so the guard must not take one for an obstacle to the other's move (it did: every
+// lip stayed closed, and the next step's collision handling met in-plane contacts it could not resolve).
+TEST(CrackOpening, LipsStartApartWithTheWorldGuardOn) {
+  for (const bool border : {false, true}) {
+    Mesh mesh = make_grid(6, 4, 1.2, 0.8, Diagonal::kAlternating);
+    std::vector<Material> materials{testing::aluminium_sheet(1.0)};
+    for (Face& f : mesh.faces) f.thickness = materials[0].thickness;
+    EditSessionOptions o;
+    o.world_clearance = 1e-6;
+    EditSession session(mesh, materials, o);
+    CrackOpeningOptions c = options_with_size(0.2);
+    c.lip_gap = 2e-5;
+    const int node = border ? test::grid_node(6, 3, 4) : test::grid_node(6, 3, 2);  // (0.6, 0.8) or (0.6, 0.4)
+    std::vector<CutRay> rays{ray_along(mesh, node, Vec3(0, -1, 0))};
+    if (!border) rays.push_back(ray_along(mesh, node, Vec3(0, 1, 0)));
+    const CrackOpening opening = open_crack(session, node, rays, c);
+    ASSERT_TRUE(opening.ok) << opening.refused;
+    ASSERT_EQ(opening.nodes.size(), 2u);
+    const Vec3 gap = mesh.nodes[opening.nodes[1]].x - mesh.nodes[opening.nodes[0]].x;
+    EXPECT_NEAR(gap.norm(), c.lip_gap, 1e-3 * c.lip_gap) << (border ? "border" : "interior");
+    EXPECT_NEAR(gap.z(), 0, 1e-12) << "the lips move within the sheet's plane";
+    // Across the crack (it runs along y); a border node's copies move into their own corners, at 45 degrees.
+    EXPECT_GT(std::abs(gap.x()), (border ? 0.7 : 0.999) * c.lip_gap);
+    EXPECT_EQ(check_mesh(mesh), "");
+  }
+}
+
 TEST(CrackOpening, InteriorCutAtAnAngleSplitsTheOppositeEdgesOnThePlane) {
   // Forward diagonals: a ray 20 degrees off the vertical leaves through a face whose opposite edge is a row.
   Sheet s(make_grid(6, 4, 1.2, 0.8, Diagonal::kForward));
