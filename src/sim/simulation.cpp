@@ -41,6 +41,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   fracture.substepping = scene.fracture.substepping;
   fracture.local_remesh = scene.fracture.local_remesh;
   fracture.reproject = scene.fracture.reproject;
+  fracture.independent_openings = scene.fracture.independent_openings;
   fracture.max_cracks = scene.magic.max_cracks;
   for (Motion& m : motions_) m.finalize();
   for (size_t i = 0; i < scene.cloths.size(); ++i) load_cloth(scene.cloths[i], static_cast<int>(i));
