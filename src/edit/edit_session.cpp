@@ -88,7 +88,12 @@ EditSession::EditSession(Mesh& mesh, const std::vector<Material>& materials, Edi
   for (const Face& f : m_.faces)
     if (!f.dead) ++live_faces_;
   curved_reference_ = o_.reference != nullptr && o_.reference->kind() != "linear";
-  if (o_.world_clearance > 0) guard_ = std::make_unique<WorldGuard>(m_, o_.obstacles, o_.world_clearance);
+  if (o_.world_clearance > 0 && o_.shared_guard != nullptr) {
+    guard_ = o_.shared_guard;
+  } else if (o_.world_clearance > 0) {
+    own_guard_ = std::make_unique<WorldGuard>(m_, o_.obstacles, o_.world_clearance);
+    guard_ = own_guard_.get();
+  }
 }
 
 EditSession::~EditSession() = default;

@@ -89,6 +89,10 @@ struct EditSessionOptions {
   // itself and `obstacles`), or come no closer than before. <= 0: off.
   double world_clearance = 0;
   std::vector<const Mesh*> obstacles;
+  // A guard built once for several sessions in a row (fracture's substeps; building one indexes the whole mesh
+  // and its obstacles). Valid while every edit and node move of the mesh goes through sessions sharing it (moves
+  // that are undone exactly, like fracture's rewound prediction, need not). nullptr: each session builds its own.
+  WorldGuard* shared_guard = nullptr;
 };
 
 // What the session did, summed over its edits.
@@ -173,7 +177,8 @@ class EditSession {
   bool whole_mesh_ = true;
   std::vector<char> zone_;
   long live_faces_ = 0;
-  std::unique_ptr<WorldGuard> guard_;
+  std::unique_ptr<WorldGuard> own_guard_;
+  WorldGuard* guard_ = nullptr;  // own_guard_ or the options' shared guard
   std::vector<EditObserver*> observers_;
   EditCounts counts_;
 };

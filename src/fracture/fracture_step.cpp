@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
+#include <memory>
 
 #include "fracture/fracture_stress.hpp"
 #include "math/errors.hpp"
@@ -36,6 +38,49 @@ struct Candidate {
     return a != b ? a > b : separation.node < o.separation.node;
   }
 };
+
+// Collects the nodes whose fans the edits changed (corners of the faces an edit added or removed, and the nodes
+// it added or removed): the nodes whose lumped masses need recomputing.
+class TouchedNodes : public EditObserver {
+ public:
+  explicit TouchedNodes(const Mesh& mesh) : mesh_(mesh) {}
+  void stage_done(EditKind, EditStage stage, const EditResult& r) override {
+    if (stage != EditStage::kDone || !r.ok) return;
+    for (const std::vector<int>* faces : {&r.added_faces, &r.removed_faces})
+      for (int f : *faces)
+        for (int i = 0; i < 3; ++i) {
+          const int v = mesh_.faces[f].v[i];
+          if (v >= 0 && v < static_cast<int>(mesh_.verts.size())) nodes_.push_back(mesh_.verts[v].node);
+        }
+    nodes_.insert(nodes_.end(), r.added_nodes.begin(), r.added_nodes.end());
+    nodes_.insert(nodes_.end(), r.removed_nodes.begin(), r.removed_nodes.end());
+  }
+  // The nodes collected since the last call (sorted, unique), and forgets them.
+  std::vector<int> take() {
+    std::vector<int> out;
+    out.swap(nodes_);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+ private:
+  const Mesh& mesh_;
+  std::vector<int> nodes_;
+};
+
+// What the substeps of one fracture pass share: one world guard for all their edit sessions (building one
+// indexes the whole mesh and its obstacles, far more than a substep's zone costs), and the record of touched
+// nodes whose masses are brought up to date after each edit batch.
+struct PassState {
+  std::unique_ptr<WorldGuard> guard;
+  TouchedNodes touched;
+  explicit PassState(const Mesh& mesh) : touched(mesh) {}
+};
+
+void refresh_masses(Mesh& mesh, const std::vector<Material>& materials, PassState& pass) {
+  update_node_masses(mesh, materials, pass.touched.take());
+}
 
 // The breaking nodes among `nodes` (live ones, not refused in this step), strongest first.
 std::vector<Candidate> breaking_nodes(const Mesh& mesh, const std::vector<Material>& materials,
@@ -105,31 +150,39 @@ CrackOpeningOptions opening_options(const FractureParams& params, const Fracture
   return o;
 }
 
-EditSessionOptions session_options(const FractureParams& params, const FractureContext& context) {
+EditSessionOptions session_options(const FractureParams& params, const FractureContext& context,
+                                   PassState& pass) {
   EditSessionOptions o = edit_session_options(context.remesh);
   o.reproject = params.reproject && o.reproject;
+  o.shared_guard = pass.guard.get();
   return o;
 }
 
-// Opens a crack at the candidate through a fresh edit session (the world guard sees the mesh as it is now).
+// Opens a crack at the candidate through a fresh edit session (sharing the pass's world guard, which every
+// edit of the pass keeps current) and brings the masses of the nodes it touched up to date.
 CrackOpening open_at(Mesh& mesh, const std::vector<Material>& materials, const Candidate& c,
-                     const FractureParams& params, const FractureContext& context, FractureStats& stats) {
-  EditSession session(mesh, materials, session_options(params, context));
+                     const FractureParams& params, const FractureContext& context, PassState& pass,
+                     FractureStats& stats) {
+  EditSession session(mesh, materials, session_options(params, context, pass));
+  session.add_observer(&pass.touched);
   CrackOpening opening = open_crack(session, c.separation.node, c.separation.rays, opening_options(params, context));
   stats.edited = stats.edited || session.edited();
   if (opening.ok)
     ++stats.cracks;
   else
     ++stats.refused;
+  refresh_masses(mesh, materials, pass);
   return opening;
 }
 
 // Step 2b: refines the zone's interior to size_min. Returns the zone's nodes after the edits.
 std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
-                             const FractureContext& context, FractureStats& stats) {
+                             const FractureContext& context, PassState& pass, FractureStats& stats) {
   RemeshOptions o = context.remesh;
   o.extras = SizingExtras();
   o.extras.uniform_size = size_min_of(context);
+  o.shared_guard = pass.guard.get();
+  o.observers.push_back(&pass.touched);
   const std::vector<int> faces = interior_faces(mesh, zone);
   if (faces.empty()) return zone;
   const RemeshStats r = remesh_mesh(mesh, materials, o, &faces);
@@ -137,7 +190,7 @@ std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials,
   if (edits == 0) return zone;
   stats.remesh_edits += edits;
   stats.edited = true;
-  update_node_masses(mesh, materials);
+  refresh_masses(mesh, materials, pass);
   std::vector<int> nodes = nodes_of_faces(mesh, r.active_faces);
   for (int n : zone)
     if (!mesh.nodes[n].dead) nodes.push_back(n);
@@ -192,18 +245,69 @@ void mark(std::vector<char>& flags, int n) {
 // earlier opening changed is skipped (its evaluation is stale).
 void open_without_substepping(Mesh& mesh, const std::vector<Material>& materials,
                               const std::vector<Candidate>& candidates, const FractureParams& params,
-                              const FractureContext& context, FractureStats& stats) {
+                              const FractureContext& context, PassState& pass, FractureStats& stats) {
   std::vector<char> touched(mesh.nodes.size(), 0);
   for (const Candidate& c : candidates) {
     if (stats.cracks >= params.max_cracks) break;
     const int n = c.separation.node;
     if (mesh.nodes[n].dead || (n < static_cast<int>(touched.size()) && touched[n])) continue;
     std::vector<int> fan_nodes = node_rings(mesh, {n}, 1);
-    const CrackOpening opening = open_at(mesh, materials, c, params, context, stats);
+    const CrackOpening opening = open_at(mesh, materials, c, params, context, pass, stats);
     if (!opening.ok) continue;
     for (int m : fan_nodes) mark(touched, m);
     for (int m : opening.nodes) mark(touched, m);
   }
+}
+
+// The nodes within `rings` rings of the opening (its node, the node's copies and the new tips; for a refused
+// opening, the node), on the mesh as it is after it, merged into the sorted `region`.
+void add_opening_region(const Mesh& mesh, int node, const CrackOpening& opening, int rings,
+                        std::vector<int>& region) {
+  std::vector<int> seeds = opening.nodes;
+  seeds.push_back(node);
+  seeds.insert(seeds.end(), opening.tips.begin(), opening.tips.end());
+  seeds.erase(std::remove_if(seeds.begin(), seeds.end(),
+                             [&](int n) { return n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead; }),
+              seeds.end());
+  const std::vector<int> near = node_rings(mesh, seeds, rings);
+  std::vector<int> merged;
+  merged.reserve(region.size() + near.size());
+  std::set_union(region.begin(), region.end(), near.begin(), near.end(), std::back_inserter(merged));
+  region = std::move(merged);
+}
+
+// Step 2e: opens the strongest candidate of the prediction and, with independent openings, every further one
+// (strongest first) that lies more than 2 (zone_rings + 1) rings from each node opened so far in this substep.
+// Returns the next substep's Z: the candidates not opened (nor refused) and the new crack tips.
+std::vector<int> open_candidates(Mesh& mesh, const std::vector<Material>& materials,
+                                 const std::vector<Candidate>& candidates, const FractureParams& params,
+                                 const FractureContext& context, PassState& pass, std::vector<char>& refused,
+                                 FractureStats& stats) {
+  const int separation = 2 * (std::max(params.zone_rings, 0) + 1);
+  std::vector<int> region;  // nodes within `separation` rings of this substep's openings (sorted)
+  std::vector<int> zone;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const int n = candidates[k].separation.node;
+    const bool may_open = stats.cracks < params.max_cracks && !mesh.nodes[n].dead &&
+                          (k == 0 || (params.independent_openings && !std::binary_search(region.begin(), region.end(), n)));
+    if (!may_open) {
+      zone.push_back(n);
+      continue;
+    }
+    const CrackOpening opening = open_at(mesh, materials, candidates[k], params, context, pass, stats);
+    if (!opening.ok) mark(refused, n);
+    if (opening.ok) zone.insert(zone.end(), opening.tips.begin(), opening.tips.end());
+    if (params.independent_openings) add_opening_region(mesh, n, opening, separation, region);
+  }
+  zone.erase(std::remove_if(zone.begin(), zone.end(),
+                            [&](int n) {
+                              return n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead ||
+                                     (n < static_cast<int>(refused.size()) && refused[n]);
+                            }),
+             zone.end());
+  std::sort(zone.begin(), zone.end());
+  zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+  return zone;
 }
 
 }  // namespace
@@ -220,10 +324,17 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
       breaking_nodes(mesh, materials, live_nodes(mesh), stress, refused, params.separation);
   stats.candidates = static_cast<int>(candidates.size());
   if (!candidates.empty()) stats.max_ratio = candidates.front().separation.ratio();
+  if (candidates.empty()) {
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+  }
 
-  if (!candidates.empty() && !params.substepping) {
-    open_without_substepping(mesh, materials, candidates, params, context, stats);
-  } else if (!candidates.empty()) {
+  PassState pass(mesh);
+  if (context.remesh.world_clearance > 0)
+    pass.guard = std::make_unique<WorldGuard>(mesh, context.remesh.obstacles, context.remesh.world_clearance);
+  if (!params.substepping) {
+    open_without_substepping(mesh, materials, candidates, params, context, pass, stats);
+  } else {
     std::vector<int> zone;
     for (const Candidate& c : candidates) zone.push_back(c.separation.node);
     const bool remesh_locally = params.local_remesh && size_min_of(context) > 0;
@@ -232,26 +343,13 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
     while (!zone.empty() && stats.cracks < params.max_cracks && stats.substeps < max_iterations) {
       ++stats.substeps;
       std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
-      if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, stats);
+      if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, pass, stats);
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
       candidates = predict(mesh, materials, zone_nodes, context, zone_solver, stress, refused, params.separation);
       if (candidates.empty()) break;
-      const CrackOpening opening = open_at(mesh, materials, candidates.front(), params, context, stats);
-      if (!opening.ok) mark(refused, candidates.front().separation.node);
-      if (stats.edited) update_node_masses(mesh, materials);
-      zone.clear();
-      for (size_t i = 1; i < candidates.size(); ++i) zone.push_back(candidates[i].separation.node);
-      if (opening.ok) zone.insert(zone.end(), opening.tips.begin(), opening.tips.end());
-      zone.erase(std::remove_if(zone.begin(), zone.end(),
-                                [&](int n) {
-                                  return n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead;
-                                }),
-                 zone.end());
-      std::sort(zone.begin(), zone.end());
-      zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+      zone = open_candidates(mesh, materials, candidates, params, context, pass, refused, stats);
     }
   }
-  if (stats.edited) update_node_masses(mesh, materials);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

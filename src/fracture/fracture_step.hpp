@@ -18,6 +18,14 @@
 //      e. the node with the largest s / tau opens (fracture/crack_opening.hpp, through one edit session):
 //         Z = the nodes of Z' with s > tau, minus the opened node, plus the new crack tips. A refused opening
 //         is logged and that node is not tried again in this step.
+//         Independent openings (FractureParams::independent_openings, the default; "substep_openings" in the
+//         scene's "fracture" object): the further breaking nodes of the same prediction open too, strongest
+//         first, each if it lies more than 2 (zone_rings + 1) rings (mesh graph, measured after the openings
+//         before it) from every node opened or refused in this substep. Their zones (n rings) can then not
+//         touch, so one opening cannot change the other's neighbourhood; a substep costs one prediction for
+//         many openings where the breaking region is large (an impact). false: the strict Algorithm 1.
+//   Work per substep follows the zone, not the mesh: sigma+ and normals only for the zone's faces, masses only
+//   for the nodes an edit touched, sizing only for the zone's verts, one world guard for the whole pass.
 //   At the end the node positions are the step's positions (up to the edit session's local reprojection of
 //   the split nodes, Eq. 13): only the topology changed.
 //
@@ -44,6 +52,10 @@ struct FractureParams {
   bool substepping = true;   // Algorithm 1; false: the ablation described above
   bool local_remesh = true;  // step 2b (needs the remeshing module and a finite size_min)
   bool reproject = true;     // Eq. 13 after each opening
+  // false: one opening per substep (the strict Algorithm 1). true: step 2e also opens the further candidates of
+  // the same prediction, strongest first, that lie more than 2 (zone_rings + 1) rings from every node opened
+  // in this substep (see above).
+  bool independent_openings = true;
   SeparationOptions separation;
   CrackOpeningOptions opening;  // opening.size_min is taken from remesh.sizing.remeshing.size_min
 };

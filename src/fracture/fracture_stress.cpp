@@ -39,9 +39,10 @@ bool is_breakable(const Face& face, const std::vector<Material>& materials) {
   return !face.dead && materials[face.material].toughness > 0;
 }
 
-bool needs_normals(const Mesh& mesh, const std::vector<Material>& materials) {
-  for (const Face& face : mesh.faces)
-    if (is_breakable(face, materials) && materials[face.material].fracture_bending_mult > 0) return true;
+bool needs_normals(const Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& faces) {
+  for (int f : faces)
+    if (is_breakable(mesh.faces[f], materials) && materials[mesh.faces[f].material].fracture_bending_mult > 0)
+      return true;
   return false;
 }
 
@@ -117,9 +118,27 @@ void update_fracture_stresses(const Mesh& mesh, const std::vector<Material>& mat
                               const std::vector<int>& faces, std::vector<FaceFractureStress>& out) {
   out.resize(mesh.faces.size());
   std::vector<Vec3> node_normals, vert_normals;
-  if (needs_normals(mesh, materials)) {
+  if (faces.size() == mesh.faces.size() && needs_normals(mesh, materials, faces)) {
     node_normals = world_node_normals(mesh);
     vert_normals = rest_vert_normals(mesh);
+  } else if (needs_normals(mesh, materials, faces)) {
+    // Only the normals the faces read: their corners' (O(faces), not O(mesh), for a zone's faces).
+    std::vector<int> nodes, verts;
+    nodes.reserve(3 * faces.size());
+    verts.reserve(3 * faces.size());
+    for (int f : faces) {
+      if (mesh.faces[f].dead) continue;
+      for (int i = 0; i < 3; ++i) {
+        nodes.push_back(mesh.face_node(f, i));
+        verts.push_back(mesh.faces[f].v[i]);
+      }
+    }
+    for (std::vector<int>* list : {&nodes, &verts}) {
+      std::sort(list->begin(), list->end());
+      list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+    update_world_node_normals(mesh, nodes, node_normals);
+    update_rest_vert_normals(mesh, verts, vert_normals);
   }
   const int count = static_cast<int>(faces.size());
   // Each face writes only its own slot: the result does not depend on the thread count.

@@ -54,7 +54,8 @@ FaceFractureStress face_fracture_stress(const Mesh& mesh, const std::vector<Mate
 // deterministic.
 std::vector<FaceFractureStress> fracture_stresses(const Mesh& mesh, const std::vector<Material>& materials);
 
-// The same for a subset of faces only (others left as they are in `out`, which is resized to mesh.faces).
+// The same for a subset of faces only (others left as they are in `out`, which is resized to mesh.faces). Only
+// the normals of the subset's corners are computed (the same values): the cost follows the subset.
 void update_fracture_stresses(const Mesh& mesh, const std::vector<Material>& materials,
                               const std::vector<int>& faces, std::vector<FaceFractureStress>& out);
 

@@ -492,6 +492,12 @@ class SceneParser {
     s.substepping = get_bool(r.get("substepping"), s.substepping);
     s.local_remesh = get_bool(r.get("local_remesh"), s.local_remesh);
     s.reproject = get_bool(r.get("reproject"), s.reproject);
+    if (const Found openings = r.get("substep_openings")) {
+      const std::string mode = to_string(*openings.value, openings.at);
+      if (mode != "one" && mode != "independent")
+        fail(openings.at, "must be \"one\" or \"independent\", got \"" + mode + "\"");
+      s.independent_openings = mode == "independent";
+    }
     r.warn_unknown();
   }
 

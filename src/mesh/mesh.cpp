@@ -347,4 +347,43 @@ std::vector<Vec3> rest_vert_normals(const Mesh& mesh) {
   return normalized(std::move(sums));
 }
 
+namespace {
+
+Vec3 unit_or_zero(const Vec3& n) {
+  const double len = n.norm();
+  return len > 0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+}  // namespace
+
+void update_world_node_normals(const Mesh& mesh, const std::vector<int>& nodes, std::vector<Vec3>& normals) {
+  normals.resize(mesh.nodes.size(), Vec3::Zero());
+  for (int n : nodes) {
+    Vec3 sum = Vec3::Zero();
+    for (int fi : mesh.node_faces(n)) {  // ascending
+      if (mesh.faces[fi].dead) continue;
+      const Vec3& x0 = mesh.nodes[mesh.face_node(fi, 0)].x;
+      sum += (mesh.nodes[mesh.face_node(fi, 1)].x - x0).cross(mesh.nodes[mesh.face_node(fi, 2)].x - x0);
+    }
+    normals[n] = unit_or_zero(sum);
+  }
+}
+
+void update_rest_vert_normals(const Mesh& mesh, const std::vector<int>& verts, std::vector<Vec3>& normals) {
+  normals.resize(mesh.verts.size(), Vec3::Zero());
+  std::vector<int> around;
+  for (int v : verts) {
+    around = mesh.verts[v].faces;
+    std::sort(around.begin(), around.end());
+    Vec3 sum = Vec3::Zero();
+    for (int f : around) {
+      const Face& face = mesh.faces[f];
+      if (face.dead) continue;
+      const Vec3& u0 = mesh.verts[face.v[0]].u;
+      sum += (mesh.verts[face.v[1]].u - u0).cross(mesh.verts[face.v[2]].u - u0);
+    }
+    normals[v] = unit_or_zero(sum);
+  }
+}
+
 }  // namespace arcsim

@@ -145,5 +145,10 @@ double dihedral_angle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3
 // rest space per vert (indexed like mesh.verts).
 std::vector<Vec3> world_node_normals(const Mesh& mesh);
 std::vector<Vec3> rest_vert_normals(const Mesh& mesh);
+// The same normals for the listed nodes / verts only, written into `normals` (indexed like mesh.nodes /
+// mesh.verts; resized to it, other entries left as they are). Bit-identical to the whole-mesh functions (the
+// faces are summed in the same order); the cost is the listed elements' fans.
+void update_world_node_normals(const Mesh& mesh, const std::vector<int>& nodes, std::vector<Vec3>& normals);
+void update_rest_vert_normals(const Mesh& mesh, const std::vector<int>& verts, std::vector<Vec3>& normals);
 
 }  // namespace arcsim

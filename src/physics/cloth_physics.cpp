@@ -51,6 +51,17 @@ void update_node_masses(Mesh& mesh, const std::vector<Material>& materials) {
   }
 }
 
+void update_node_masses(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& nodes) {
+  for (int n : nodes) {
+    if (n < 0 || n >= static_cast<int>(mesh.nodes.size())) continue;
+    double mass = 0;
+    if (!mesh.nodes[n].dead)
+      for (int f : mesh.node_faces(n))  // ascending, as the whole-mesh loop adds them
+        if (!mesh.faces[f].dead) mass += face_corner_mass(mesh.faces[f], materials[mesh.faces[f].material]);
+    mesh.nodes[n].mass = mass;
+  }
+}
+
 void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache) {
   cache.faces.clear();
   cache.bending.clear();

@@ -48,6 +48,8 @@ struct ContactTerm {
 
 // Recomputes node masses (kg) from face area densities.
 void update_node_masses(Mesh& mesh, const std::vector<Material>& materials);
+// The same for the listed nodes only (the nodes an edit's faces touch): bit-identical values, cost of their fans.
+void update_node_masses(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& nodes);
 
 // Builds the element cache (and the block pattern) for the mesh's current topology and rest state.
 void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache);

@@ -143,14 +143,21 @@ class Remesher {
  public:
   Remesher(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
            const std::vector<int>* subset)
-      : m_(mesh), materials_(materials), o_(options), session_(mesh, materials, edit_session_options(options), subset) {
+      : m_(mesh), materials_(materials), o_(options), subset_(subset),
+        session_(mesh, materials, edit_session_options(options), subset) {
+    for (EditObserver* observer : o_.observers) session_.add_observer(observer);
     const RemeshingParams& r = o_.sizing.remeshing;
     aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
     min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
   }
 
   RemeshStats run() {
-    compute_vertex_sizing(m_, o_.sizing, o_.extras);
+    // A subset's edits read only the sizing of its faces' verts (splits of its edges, flips and collapses inside
+    // it, and the verts new edits make interpolate it).
+    if (subset_ != nullptr)
+      compute_vertex_sizing(m_, o_.sizing, o_.extras, *subset_);
+    else
+      compute_vertex_sizing(m_, o_.sizing, o_.extras);
     flip_edges(active_edges());
     split_rounds();
     collapse_rounds();
@@ -392,6 +399,7 @@ class Remesher {
   Mesh& m_;
   const std::vector<Material>& materials_;
   const RemeshOptions& o_;
+  const std::vector<int>* subset_;
   EditSession session_;
   double aspect_min_ = 0, min_area_ = 0;
 };
@@ -406,6 +414,7 @@ EditSessionOptions edit_session_options(const RemeshOptions& o) {
   s.reprojection = o.reprojection;
   s.world_clearance = o.world_clearance;
   s.obstacles = o.obstacles;
+  s.shared_guard = o.shared_guard;
   return s;
 }
 

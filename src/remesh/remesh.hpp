@@ -43,6 +43,8 @@ struct RemeshOptions {
   // surface they do not touch (the mesh itself and `obstacles`), or come no closer than before. <= 0: off.
   double world_clearance = 0;
   std::vector<const Mesh*> obstacles;  // other surfaces the edits may not approach: obstacles, other cloths
+  WorldGuard* shared_guard = nullptr;  // see EditSessionOptions::shared_guard
+  std::vector<EditObserver*> observers;  // told about every edit of the pass (edit/edit_session.hpp)
   int max_rounds = 30;                 // split rounds and collapse rounds, each
   size_t max_faces = 2000000;          // no split beyond this many live faces (a safety net, not a size control)
 };

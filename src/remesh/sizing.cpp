@@ -163,6 +163,35 @@ void compute_vertex_sizing(Mesh& mesh, const SizingParams& params, const SizingE
     if (weight[v] > 0) mesh.verts[v].sizing /= weight[v];
 }
 
+void compute_vertex_sizing(Mesh& mesh, const SizingParams& params, const SizingExtras& extras,
+                           const std::vector<int>& faces) {
+  std::vector<int> verts;
+  for (int f : faces)
+    if (f >= 0 && f < static_cast<int>(mesh.faces.size()) && !mesh.faces[f].dead)
+      for (int corner = 0; corner < 3; ++corner) {
+        // Every vert of the corner's node: a border edge of the subset on a seam is measured in both faces.
+        const std::vector<int>& of_node = mesh.nodes[mesh.face_node(f, corner)].verts;
+        verts.insert(verts.end(), of_node.begin(), of_node.end());
+      }
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  std::vector<int> around;
+  for (int v : verts) {
+    // Ascending face order, as the whole-mesh loop adds them.
+    around = mesh.verts[v].faces;
+    std::sort(around.begin(), around.end());
+    Mat3 sum = Mat3::Zero();
+    double weight = 0;
+    for (int f : around) {
+      const Face& face = mesh.faces[f];
+      if (face.dead) continue;
+      sum += face.rest_area * face_metric_to_rest(face, face_sizing(mesh, f, params, extras));
+      weight += face.rest_area;
+    }
+    mesh.verts[v].sizing = weight > 0 ? Mat3(sum / weight) : Mat3::Zero();
+  }
+}
+
 double vert_pair_metric_length(const Mesh& mesh, int a, int b) {
   const Vec3 du = mesh.verts[b].u - mesh.verts[a].u;
   const double m = 0.5 * (du.dot(mesh.verts[a].sizing * du) + du.dot(mesh.verts[b].sizing * du));

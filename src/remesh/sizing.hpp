@@ -77,6 +77,12 @@ Mat3 face_metric_to_rest(const Face& face, const Mat2& M);
 // Sets every live vert's sizing to the rest-area-weighted mean of its faces' metrics (3x3, rest space).
 void compute_vertex_sizing(Mesh& mesh, const SizingParams& params, const SizingExtras& extras);
 
+// The same for the verts of the given faces' nodes only (each from all its live faces, summed in the same order, so
+// the values are those compute_vertex_sizing gives them); other verts keep their sizing. Cost: the faces'
+// neighbourhood, not the mesh.
+void compute_vertex_sizing(Mesh& mesh, const SizingParams& params, const SizingExtras& extras,
+                           const std::vector<int>& faces);
+
 // Metric length of the rest segment between verts a and b: sqrt of the mean over both ends of
 // du^T sizing du (dimensionless; > 1 means too long).
 double vert_pair_metric_length(const Mesh& mesh, int vert_a, int vert_b);

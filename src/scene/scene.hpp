@@ -94,6 +94,10 @@ struct FractureSpec {
   bool substepping = true;    // false: the paper's ablation (one evaluation, no virtual update)
   bool local_remesh = true;   // refine the zone to size_min before predicting
   bool reproject = true;      // Eq. 13 after each opening
+  // Openings per substep: false ("substep_openings": "one") is the strict Algorithm 1, one opening per
+  // prediction; true ("independent", the default) also opens the further breaking nodes of the same prediction
+  // that lie more than 2 (zone_rings + 1) rings from every node opened in that substep (fracture_step.hpp).
+  bool independent_openings = true;
 };
 
 struct Scene {

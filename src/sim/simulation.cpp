@@ -41,6 +41,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   fracture.substepping = scene.fracture.substepping;
   fracture.local_remesh = scene.fracture.local_remesh;
   fracture.reproject = scene.fracture.reproject;
+  fracture.independent_openings = scene.fracture.independent_openings;
   fracture.max_cracks = scene.magic.max_cracks;
   // New lips start apart by twice the projection thickness: closer, they would count as touching (an in-plane
   // contact with no room to resolve it) from their first step on.

@@ -299,6 +299,10 @@ const std::vector<BadCase>& bad_cases() {
        ""},
       {"fracture_substepping_not_bool", [](Json::Value& j) { j["fracture"]["substepping"] = "yes"; },
        "fracture.substepping", ""},
+      {"substep_openings_unknown", [](Json::Value& j) { j["fracture"]["substep_openings"] = "all"; },
+       "fracture.substep_openings", "must be \"one\" or \"independent\", got \"all\""},
+      {"substep_openings_not_string", [](Json::Value& j) { j["fracture"]["substep_openings"] = 1; },
+       "fracture.substep_openings", ""},
       {"handle_motion_out_of_range", [](Json::Value& j) { j["handles"][0]["motion"] = 5; }, "handles[0].motion",
        "out of range"},
       {"handle_cloth_out_of_range", [](Json::Value& j) { j["handles"][0]["cloth"] = 1; }, "handles[0].cloth",
@@ -546,6 +550,22 @@ TEST(SceneParser, ObstaclePatternLoadsNumberedFilesAndMotions) {
   SceneFixture g(k);
   const std::string message = error_of(g);
   EXPECT_NE(message.find("obstacles: file \"obs/none_0.obj\" not found"), std::string::npos) << message;
+}
+
+TEST(SceneParser, FractureSubstepOpenings) {
+  Json::Value j = base_scene();
+  {
+    SceneFixture f(j);
+    EXPECT_TRUE(f.load().fracture.independent_openings);  // the default
+  }
+  j["fracture"]["substep_openings"] = "one";
+  {
+    SceneFixture f(j);
+    EXPECT_FALSE(f.load().fracture.independent_openings);  // the strict Algorithm 1
+  }
+  j["fracture"]["substep_openings"] = "independent";
+  SceneFixture f(j);
+  EXPECT_TRUE(f.load().fracture.independent_openings);
 }
 
 TEST(SceneParser, MagicAndWind) {
