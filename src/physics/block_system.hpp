@@ -84,9 +84,10 @@ void BlockSystem::add_element(const std::array<int, N>& nodes, const std::array<
   for (int a = 0; a < N; ++a) {
     for (int b = 0; b < N; ++b) {
       if (nodes[a] < 0 || nodes[b] < 0) continue;
-      // Each unordered pair once: take (a, b) where node a is the block's row (>= column).
+      // Each unordered pair once: take (a, b) where node a is the block's row (>= column). A node in two slots
+      // (a bending element whose wings coincide, at a valence-3 node) gets K_ab + K_ba on its diagonal block, as
+      // the chain rule says; dropping them left the assembled matrix indefinite (paper-tearing.json, frame 665).
       if (nodes[a] < nodes[b]) continue;
-      if (nodes[a] == nodes[b] && a != b) continue;  // repeated node (degenerate element): skip safely
       blocks[block_ids[a * N + b]] += scale * K.template block<3, 3>(3 * a, 3 * b);
     }
   }

@@ -215,8 +215,7 @@ void assemble_contact(const Mesh& mesh, const ContactTerm& c, const std::array<i
     system.rhs.segment<3>(3 * da) += dt * c.weights[a] * force;
     for (int b = 0; b < 4; ++b) {
       const int db = dofs[b];
-      if (db < 0 || db > da) continue;  // lower blocks only
-      if (db == da && b != a) continue;  // a node listed twice: its own term once per listing
+      if (db < 0 || db > da) continue;  // lower blocks only; a node listed twice also gets the cross terms
       const int block = pattern.block_index(da, db);
       system.blocks[block] += c.weights[a] * c.weights[b] * K;
     }

@@ -70,6 +70,32 @@ TEST(BlockSystem, MatchesDenseAssemblyAndSolves) {
   EXPECT_EQ(solver.analyses(), 2);
 }
 
+// An element with one node in two slots (a bending element whose wings coincide, at a valence-3 node) adds
+// its cross blocks to that node's diagonal: the assembled matrix is P K P^T, PSD like K. Dropping them left a
+// PSD element's contribution indefinite (ARCSim's paper-tearing.json failed its factorisation at frame 665).
+TEST(BlockSystem, RepeatedNodeGetsTheCrossBlocks) {
+  BlockPattern pattern;
+  pattern.build(2, {{0, 1}});
+  BlockSystem system;
+  system.reset(pattern);
+  const std::array<int, 3> e{0, 1, 1};
+  // K = v v^T with v moving slot 1 and slot 2 opposite ways: an energy of x_1 - x_2 = 0 for the merged node,
+  // so P K P^T has no stiffness on node 1 along v; without the cross blocks it would keep 2 |v_1|^2.
+  Eigen::Matrix<double, 9, 1> v = Eigen::Matrix<double, 9, 1>::Zero();
+  v.segment<3>(3) = Vec3(1, 0, 0);
+  v.segment<3>(6) = Vec3(-1, 0, 0);
+  Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Random();
+  const Eigen::Matrix<double, 9, 9> K = v * v.transpose() + 0.1 * A * A.transpose();
+  system.add_element<3>(e, element_block_ids<3>(pattern, e), K, 1.0);
+  Eigen::Matrix<double, 9, 6> P = Eigen::Matrix<double, 9, 6>::Zero();
+  P.block<3, 3>(0, 0) = Mat3::Identity();
+  P.block<3, 3>(3, 3) = Mat3::Identity();
+  P.block<3, 3>(6, 3) = Mat3::Identity();
+  const Eigen::Matrix<double, 6, 6> expected = P.transpose() * K * P;
+  const VecX x = VecX::Random(6);
+  EXPECT_LT((system.multiply(x) - expected * x).norm(), 1e-12 * (expected * x).norm());
+}
+
 TEST(BlockSystem, IndefiniteMatrixIsReportedNotSolved) {
   BlockPattern pattern;
   pattern.build(2, {{0, 1}});
