@@ -183,6 +183,24 @@ bool apply_plan(EditSession& session, int node, const RayPlan& plan, CrackOpenin
   return true;
 }
 
+// The faces reachable from face `start` without crossing a border or one of `cut` edges, counted up to
+// `limit` (the count stops there): the size of the piece the cut would leave `start` in, if it is small.
+int piece_faces(const Mesh& m, int start, const std::vector<int>& cut, int limit) {
+  std::vector<int> seen{start}, stack{start};
+  while (!stack.empty() && static_cast<int>(seen.size()) < limit) {
+    const int f = stack.back();
+    stack.pop_back();
+    for (int e : m.faces[f].e) {
+      if (m.edges[e].is_boundary() || std::find(cut.begin(), cut.end(), e) != cut.end()) continue;
+      const int g = m.other_face(e, f);
+      if (g == kNone || std::find(seen.begin(), seen.end(), g) != seen.end()) continue;
+      seen.push_back(g);
+      stack.push_back(g);
+    }
+  }
+  return static_cast<int>(seen.size());
+}
+
 // Moves a node of a new crack by `distance` (m) away from the other side(s) of the split, `twins` (the split
 // node and its copies): along its own faces' centroid minus the centroid of all the copies' faces, within its
 // faces' mean world plane. The guard does not check the move against the twins' faces, which it touches by
@@ -246,6 +264,10 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
     const int far = far_end(m, e, node);
     if (!m.is_boundary_node(far)) tips.push_back(far);
   }
+  if (options.min_piece_faces > 1)
+    for (int f : m.node_faces(node))
+      if (piece_faces(m, f, out.crack_edges, options.min_piece_faces) < options.min_piece_faces)
+        return refuse(out, "the crack would cut off a piece of fewer than min_piece_faces faces");
   const EditResult r = session.split_node(node, out.crack_edges);
   if (!r.ok) return refuse(out, "the edit session refused the node split");
   out.mesh_changed = true;

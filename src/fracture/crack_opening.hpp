@@ -55,6 +55,10 @@ struct CrackOpeningOptions {
   double lip_gap = 2e-6;
   double sliver = 0.05;           // refused: an edge shorter than sliver * size_min, a face of area below
                                   // (sliver * size_min)^2
+  // Refused: an opening that would cut off a piece of fewer faces. A shard of one or two triangles is below
+  // any resolution the sheet has, and it starts coincident with the faces it broke from, an in-plane contact
+  // that collision handling cannot resolve (paper-tearing.json, frame 1101: a one-triangle shard at the tip).
+  int min_piece_faces = 4;
 };
 
 struct CrackOpening {
