@@ -57,7 +57,7 @@ struct FractureParams {
   // in this substep (see above).
   bool independent_openings = true;
   SeparationOptions separation;
-  CrackOpeningOptions opening;  // opening.size_min is taken from remesh.sizing.remeshing.size_min
+  CrackOpeningOptions opening;  // opening.size_min: remeshing size_min, else the median rest edge length
 };
 
 // What the simulation hands to one fracture pass of a cloth.

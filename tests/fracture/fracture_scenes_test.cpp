@@ -366,8 +366,27 @@ Vec3 on_arc(const Vec3& u, double length, double kappa) {
   return Vec3(length / 2 + radius * std::sin(s / radius), u.y(), radius * (1 - std::cos(s / radius)));
 }
 
-// Curvature at which a glass strip bent at a constant curvature rate first cracks (-1: not within max_kappa).
-double bending_onset(double alpha, double kappa_rate, double max_kappa, int* pieces_after = nullptr) {
+// A glass strip bent at a constant curvature rate until it first cracks, then held at that curvature.
+struct BendingRun {
+  double onset = -1;          // 1/m: curvature of the first crack (-1: none up to max_kappa)
+  int pieces_at_onset = 0;    // connected pieces right after the first cracking step
+  double shortest_edge = 0;   // m: shortest live rest edge right after it
+  double median_edge = 0;     // m: median rest edge length of the initial mesh
+  int cracks_while_held = 0;  // openings during the hold steps
+};
+
+double median_rest_edge(const Mesh& mesh, double* shortest) {
+  std::vector<double> lengths;
+  for (const Face& f : mesh.faces) {
+    if (f.dead) continue;
+    for (int i = 0; i < 3; ++i) lengths.push_back((mesh.verts[f.v[(i + 1) % 3]].u - mesh.verts[f.v[i]].u).norm());
+  }
+  std::sort(lengths.begin(), lengths.end());
+  if (shortest) *shortest = lengths.front();
+  return lengths[lengths.size() / 2];
+}
+
+BendingRun bend_until_crack(double alpha, double kappa_rate, double max_kappa, int hold_steps) {
   StripSpec s;
   s.length = 0.1;
   s.width = 0.02;
@@ -379,45 +398,70 @@ double bending_onset(double alpha, double kappa_rate, double max_kappa, int* pie
   StripSim run;
   build(run, s);
   Simulation& sim = *run.sim;
-  double onset = -1;
+  BendingRun out;
+  out.median_edge = median_rest_edge(sim.cloths[0].mesh, nullptr);
   for (int step = 1; step * kappa_rate <= max_kappa + 1e-12; ++step) {
     const double kappa = step * kappa_rate;
     const auto place = [&](const Vec3& u) { return on_arc(u, s.length, kappa); };
     move_clamp(sim, 0, [&](const Vec3& u) { return u.x() < s.clamp + 1e-9; }, place);
     move_clamp(sim, 1, [&](const Vec3& u) { return u.x() > s.length - s.clamp - 1e-9; }, place);
     sim.advance_step();
-    if (cracks_of_last_step(sim) > 0 && onset < 0) {
-      onset = kappa;
-      if (!pieces_after) break;
+    if (cracks_of_last_step(sim) > 0) {
+      out.onset = kappa;
+      break;
     }
   }
-  if (pieces_after) {
-    for (int step = 0; step < 20; ++step) sim.advance_step();
-    *pieces_after = count_components(sim.cloths[0].mesh);
+  if (out.onset < 0) return out;
+  const Mesh& mesh = sim.cloths[0].mesh;
+  EXPECT_EQ(check_mesh(mesh), "");
+  out.pieces_at_onset = count_components(mesh);
+  median_rest_edge(mesh, &out.shortest_edge);
+  for (int step = 0; step < hold_steps; ++step) {
+    sim.advance_step();  // the clamps stay where they are
+    out.cracks_while_held += cracks_of_last_step(sim);
   }
-  return onset;
+  return out;
 }
 
-// DISABLED (issue 12, acceptance 4 not met yet): the strip does crack, but the run then stops with "the system
-// matrix is not positive definite" (measured 2026-12-01; still so on 2026-12-02 after the lips were really set
-// apart and repeated element nodes got their cross blocks: zone solves fail first, then the full step).
-TEST(FractureBending, DISABLED_GlassStripCracksAtTheCriticalSurfaceStrain) {
-  const double alpha = 0.8, h = 1e-3;
-  const double g = 2e7 / 50e9;               // critical Green strain
+double critical_curvature(double alpha) {
+  const double h = 1e-3;
+  const double g = 2e7 / 50e9;                 // critical Green strain
   const double e = -1 + std::sqrt(1 + 2 * g);  // e + e^2/2 = g
-  const double kappa_crit = 2 * e / (alpha * h);
-  int pieces = 0;
-  const double kappa = bending_onset(alpha, kappa_crit / 100, 2 * kappa_crit, &pieces);
-  std::printf("bending: cracked at kappa %.4g 1/m, predicted %.4g 1/m; %d pieces\n", kappa, kappa_crit, pieces);
-  ASSERT_GT(kappa, 0) << "no crack up to twice the critical curvature";
-  EXPECT_NEAR(kappa, kappa_crit, 0.1 * kappa_crit);
-  EXPECT_GE(pieces, 2) << "the crack did not run across the strip";
+  return 2 * e / (alpha * h);
+}
+
+// The onset, and the crack runs across in its step. Without remeshing the crack's cuts are kept from making
+// slivers by the mesh's own edge length (snap and sliver limits): 17 um x 1 um faces were cut before, and the
+// implicit step then failed to factorise their bending stiffness.
+TEST(FractureBending, GlassStripCracksAtTheCriticalSurfaceStrain) {
+  const double kappa_crit = critical_curvature(0.8);
+  const BendingRun r = bend_until_crack(0.8, kappa_crit / 100, 2 * kappa_crit, 0);
+  std::printf("bending: cracked at kappa %.4g 1/m, predicted %.4g 1/m; %d pieces; shortest edge %.3g mm "
+              "(median %.3g mm)\n", r.onset, kappa_crit, r.pieces_at_onset, 1e3 * r.shortest_edge,
+              1e3 * r.median_edge);
+  ASSERT_GT(r.onset, 0) << "no crack up to twice the critical curvature";
+  EXPECT_NEAR(r.onset, kappa_crit, 0.1 * kappa_crit);
+  EXPECT_GE(r.pieces_at_onset, 2) << "the crack did not run across the strip";
+  EXPECT_GE(r.shortest_edge, 0.05 * r.median_edge) << "a crack cut a sliver";
+}
+
+// DISABLED (issue 12, acceptance 4's aftermath, not met): held at the onset curvature, the broken strip should
+// stop cracking (its pieces relax). Measured 2026-12-02: the first cracking step already opens max_cracks
+// (100) openings and leaves 13 pieces (22 with "substep_openings": "one"); right after the first crack has run
+// across, the virtual update predicts s / tau up to 62 beside its lips; held, every step opens 100 more, the
+// shards' lip contacts make ill-conditioned impact zones, and after a few steps the world mesh has collapsed
+// faces (5 nm high) whose bending stiffness the zone solves cannot factorise.
+TEST(FractureBending, DISABLED_HeldAtTheOnsetCurvatureTheBrokenStripStopsCracking) {
+  const double kappa_crit = critical_curvature(0.8);
+  const BendingRun r = bend_until_crack(0.8, kappa_crit / 100, 2 * kappa_crit, 20);
+  ASSERT_GT(r.onset, 0);
+  EXPECT_LE(r.pieces_at_onset, 3) << "the strip shattered instead of breaking";
+  EXPECT_EQ(r.cracks_while_held, 0);
 }
 
 TEST(FractureBending, WithoutBendingFractureTheSameCurvatureDoesNotCrack) {
-  const double g = 2e7 / 50e9;
-  const double kappa_crit = 2 * (-1 + std::sqrt(1 + 2 * g)) / (0.8 * 1e-3);
-  EXPECT_LT(bending_onset(0, kappa_crit / 50, 2 * kappa_crit), 0);
+  const double kappa_crit = critical_curvature(0.8);
+  EXPECT_LT(bend_until_crack(0, kappa_crit / 50, 2 * kappa_crit, 0).onset, 0);
 }
 
 // DISABLED (issue 12, acceptance 5 not measured yet): the buckling strip meets many unresolved self-collision
