@@ -221,7 +221,7 @@ std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials,
 // Steps 2c-d: the breaking nodes of the zone at the positions a zone step predicts, positions rewound. When the
 // zone's system cannot be solved the prediction is skipped (the stress at the current positions decides).
 std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
-                               const FractureContext& context, CholeskySolver& solver,
+                               const FractureParams& params, const FractureContext& context, CholeskySolver& solver,
                                std::vector<FaceFractureStress>& stress, const std::vector<char>& refused,
                                const SeparationOptions& options) {
   std::vector<Vec3> saved;
@@ -235,18 +235,40 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
     velocities[i] = mesh.nodes[still[i]].v;
     mesh.nodes[still[i]].v = Vec3::Zero();
   }
-  try {
-    const ZoneSolution sol = solve_zone(mesh, materials, zone, context.loads, context.dt, solver);
-    moved = sol.nodes;
-    saved.reserve(moved.size());
+  // Newton iterations of the from-rest backward Euler step (see the header): one linearised step of a bent,
+  // stiff sheet moves its nodes along tangents, and the spurious stretch of order theta^2 / 2 alone exceeds a
+  // brittle sheet's critical strain.
+  // The zone's nodes carry the iterate: x_0 + dt v_k and v_k (Linearisation::kNewtonFromRest).
+  const int iterations = std::max(params.virtual_iterations, 1);
+  double previous = kInfinity;
+  for (int it = 0; it < iterations; ++it) {
+    ZoneSolveOptions zone_options;
+    zone_options.linearisation = Linearisation::kNewtonFromRest;
+    ZoneSolution sol;
+    try {
+      sol = solve_zone(mesh, materials, zone, context.loads, context.dt, solver, zone_options);
+    } catch (const NumericalError&) {
+      if (it == 0) moved.clear(), saved.clear();
+      break;  // later iterations keep the last iterate
+    }
+    if (it == 0) {
+      moved = sol.nodes;
+      saved.reserve(moved.size());
+      for (int n : moved) saved.push_back(mesh.nodes[n].x);
+    }
+    double correction = 0, total = 0;
+    for (size_t i = 0; i < moved.size(); ++i) correction = std::max(correction, context.dt * sol.dv[i].norm());
+    // A correction larger than the one before means the iteration is not converging (the projected Hessian is
+    // not the exact one): keep the last iterate.
+    if (it > 0 && correction > previous) break;
+    previous = correction;
     for (size_t i = 0; i < moved.size(); ++i) {
       Node& n = mesh.nodes[moved[i]];
-      saved.push_back(n.x);
-      n.x += context.dt * sol.dv[i];
+      n.v += sol.dv[i];
+      n.x = saved[i] + context.dt * n.v;
+      total = std::max(total, context.dt * n.v.norm());
     }
-  } catch (const NumericalError&) {
-    moved.clear();
-    saved.clear();
+    if (it > 0 && correction <= params.virtual_tolerance * total) break;
   }
   for (size_t i = 0; i < still.size(); ++i) mesh.nodes[still[i]].v = velocities[i];
   update_fracture_stresses(mesh, materials, faces_of_nodes(mesh, zone), stress);
@@ -365,7 +387,7 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
       std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
       if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, pass, stats);
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
-      candidates = predict(mesh, materials, zone_nodes, context, zone_solver, stress, refused, params.separation);
+      candidates = predict(mesh, materials, zone_nodes, params, context, zone_solver, stress, refused, params.separation);
       if (candidates.empty()) break;
       zone = open_candidates(mesh, materials, candidates, params, context, pass, refused, stats);
     }

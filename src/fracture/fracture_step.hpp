@@ -13,7 +13,9 @@
 //         rest (v = 0 in the zone and its support); the nodes move by x + dt dv: that is the stress
 //         relaxation the opened cracks cause, not the step's motion, which the next full step makes (with the
 //         velocities in, dv would also carry -v in the stiff limit: measured on paper-tearing.json, predicted
-//         principal stresses at the notch turned by 60 degrees and tripled);
+//         principal stresses at the notch turned by 60 degrees and tripled); the step is solved by Newton
+//         iterations (virtual_iterations), because one linearised step of a bent stiff sheet stretches it
+//         along tangents by order theta^2 / 2, more than glass's critical strain;
 //      d. s for Z''s nodes at the predicted positions, then positions rewound;
 //      e. the node with the largest s / tau opens (fracture/crack_opening.hpp, through one edit session):
 //         Z = the nodes of Z' with s > tau, minus the opened node, plus the new crack tips. A refused opening
@@ -56,6 +58,10 @@ struct FractureParams {
   // the same prediction, strongest first, that lie more than 2 (zone_rings + 1) rings from every node opened
   // in this substep (see above).
   bool independent_openings = true;
+  // Newton iterations of the virtual update (at least 1; 1 is the single linearised step), stopped early once
+  // a correction moves no node by more than virtual_tolerance times its displacement so far.
+  int virtual_iterations = 4;
+  double virtual_tolerance = 1e-2;
   SeparationOptions separation;
   CrackOpeningOptions opening;  // opening.size_min: remeshing size_min, else the median rest edge length
 };

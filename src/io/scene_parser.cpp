@@ -492,6 +492,7 @@ class SceneParser {
     s.substepping = get_bool(r.get("substepping"), s.substepping);
     s.local_remesh = get_bool(r.get("local_remesh"), s.local_remesh);
     s.reproject = get_bool(r.get("reproject"), s.reproject);
+    s.virtual_iterations = get_int(r.get("virtual_iterations"), s.virtual_iterations, 1, 50);
     if (const Found openings = r.get("substep_openings")) {
       const std::string mode = to_string(*openings.value, openings.at);
       if (mode != "one" && mode != "independent")

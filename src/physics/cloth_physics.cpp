@@ -304,7 +304,8 @@ double assemble_internal(const Mesh& mesh, const ElementCache& cache, const Inte
 
 void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
-                             const ExternalLoads& loads, double dt, BlockSystem& system) {
+                             const ExternalLoads& loads, double dt, BlockSystem& system,
+                             Linearisation linearisation) {
   // Backward Euler linearised once (ARCSim): with H the PSD stiffness, beta the damping coefficient,
   //   (M + dt (dt + beta) H - dt D_v) dv = dt [ f - (dt + beta) H v + f_ext ]
   // where D_v is the velocity Jacobian of air drag. Units: blocks in kg, rhs in N s.
@@ -312,14 +313,16 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
   how.stiffness_scale = dt * dt;
   how.damping_scale = dt;
   how.force_scale = dt;
-  how.velocity_scale = dt * dt;
+  const bool newton = linearisation == Linearisation::kNewtonFromRest;
+  how.velocity_scale = newton ? 0 : dt * dt;
   how.damping_velocity_scale = dt;
   assemble_element_terms(mesh, faces, bending, how, system);
 
   for (int d = 0; d < dofs.count(); ++d) {
-    const double m = mesh.nodes[dofs.node(d)].mass;
-    system.add_diagonal(d, m * Mat3::Identity());
-    system.rhs.segment<3>(3 * d) += dt * m * loads.gravity;
+    const Node& node = mesh.nodes[dofs.node(d)];
+    system.add_diagonal(d, node.mass * Mat3::Identity());
+    system.rhs.segment<3>(3 * d) += dt * node.mass * loads.gravity;
+    if (newton) system.rhs.segment<3>(3 * d) -= node.mass * node.v;
   }
   for (const HandleSpring& s : loads.springs) {
     // Spring energy k/2 |x - target|^2, implicit in position.
@@ -327,7 +330,8 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
     if (d < 0) continue;
     const Node& node = mesh.nodes[s.node];
     system.add_diagonal(d, dt * dt * s.stiffness * Mat3::Identity());
-    system.rhs.segment<3>(3 * d) += dt * (-s.stiffness * (node.x - s.target) - dt * s.stiffness * node.v);
+    const double prediction = newton ? 0 : dt;
+    system.rhs.segment<3>(3 * d) += dt * (-s.stiffness * (node.x - s.target) - prediction * s.stiffness * node.v);
   }
   if (loads.wind.density != 0 || loads.wind.drag != 0) {
     for (const auto& el : faces) {

@@ -113,9 +113,16 @@ struct StepTiming {
 // (dof -1) enter with their positions and velocities only. Pinned nodes are not treated here: the full step
 // makes them Dirichlet rows afterwards; a zone solve leaves them out of `dofs`. Shared by implicit_euler_step and
 // solve_zone (physics/zone_solve.hpp). Blocks in kg, rhs in N s.
+// kStep: the step's single linearisation about (x, v), predicting x + dt v'. kNewtonFromRest: a Newton
+// iteration of backward Euler started from rest, with the mesh at the iterate (x_k = x_0 + dt v_k, v = v_k):
+// the same matrix, right-hand side dt [f(x_k) - beta H v_k + f_ext] - M v_k (no prediction terms), so the
+// solution is the correction of v_k. Contacts are linearised as in the step either way.
+enum class Linearisation { kStep, kNewtonFromRest };
+
 void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
-                             const ExternalLoads& loads, double dt, BlockSystem& system);
+                             const ExternalLoads& loads, double dt, BlockSystem& system,
+                             Linearisation linearisation = Linearisation::kStep);
 
 // Factorises the assembled system and solves it for dv, adding the wall times to timing.factorization and
 // timing.solve. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the

@@ -128,7 +128,7 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
 
   BlockSystem system;
   system.reset(pattern);
-  assemble_implicit_euler(mesh, faces, bending, dofs, loads, dt, system);
+  assemble_implicit_euler(mesh, faces, bending, dofs, loads, dt, system, options.linearisation);
   out.timing.assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const VecX dv = factor_and_solve(solver, system, "zone step", out.timing);
 

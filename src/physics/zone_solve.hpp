@@ -26,6 +26,9 @@ namespace arcsim {
 
 struct ZoneSolveOptions {
   int support_rings = 1;  // rings of fixed support nodes listed around the zone (>= 1)
+  // kNewtonFromRest: a Newton iteration of backward Euler started from rest, the mesh's nodes at the iterate
+  // (x_0 + dt v_k, v_k; see assemble_implicit_euler): dv is the correction of v_k.
+  Linearisation linearisation = Linearisation::kStep;
 };
 
 // The outcome of one zone step. The mesh is not changed by solve_zone: fracture evaluates a virtual update and

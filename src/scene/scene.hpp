@@ -98,6 +98,7 @@ struct FractureSpec {
   // prediction; true ("independent", the default) also opens the further breaking nodes of the same prediction
   // that lie more than 2 (zone_rings + 1) rings from every node opened in that substep (fracture_step.hpp).
   bool independent_openings = true;
+  int virtual_iterations = 4;  // Newton iterations of the virtual update (1: one linearised step)
 };
 
 struct Scene {

@@ -42,6 +42,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   fracture.local_remesh = scene.fracture.local_remesh;
   fracture.reproject = scene.fracture.reproject;
   fracture.independent_openings = scene.fracture.independent_openings;
+  fracture.virtual_iterations = scene.fracture.virtual_iterations;
   fracture.max_cracks = scene.magic.max_cracks;
   // New lips start apart by twice the projection thickness: closer, they would count as touching (an in-plane
   // contact with no room to resolve it) from their first step on.

@@ -301,6 +301,8 @@ const std::vector<BadCase>& bad_cases() {
        "fracture.substepping", ""},
       {"substep_openings_unknown", [](Json::Value& j) { j["fracture"]["substep_openings"] = "all"; },
        "fracture.substep_openings", "must be \"one\" or \"independent\", got \"all\""},
+      {"virtual_iterations_zero", [](Json::Value& j) { j["fracture"]["virtual_iterations"] = 0; },
+       "fracture.virtual_iterations", "must be in [1, 50], got 0"},
       {"substep_openings_not_string", [](Json::Value& j) { j["fracture"]["substep_openings"] = 1; },
        "fracture.substep_openings", ""},
       {"handle_motion_out_of_range", [](Json::Value& j) { j["handles"][0]["motion"] = 5; }, "handles[0].motion",
