@@ -8,6 +8,7 @@
 
 #include "fracture/fracture_stress.hpp"
 #include "math/errors.hpp"
+#include "mesh/mesh_stats.hpp"
 #include "physics/zone_solve.hpp"
 
 namespace arcsim {
@@ -151,16 +152,7 @@ double size_min_of(const FractureContext& context) {
 // implicit step could not factorise (measured: a glass strip of 2.5 mm cells).
 double crack_length_scale(const Mesh& mesh, const FractureContext& context) {
   const double size_min = size_min_of(context);
-  if (size_min > 0) return size_min;
-  std::vector<double> lengths;
-  lengths.reserve(3 * mesh.faces.size());
-  for (const Face& f : mesh.faces) {
-    if (f.dead) continue;
-    for (int i = 0; i < 3; ++i) lengths.push_back((mesh.verts[f.v[(i + 1) % 3]].u - mesh.verts[f.v[i]].u).norm());
-  }
-  if (lengths.empty()) return 0;
-  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-  return lengths[lengths.size() / 2];
+  return size_min > 0 ? size_min : mesh_size_stats(mesh).rest_edge_median;
 }
 
 CrackOpeningOptions opening_options(const FractureParams& params, const PassState& pass) {
@@ -222,8 +214,7 @@ std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials,
 // zone's system cannot be solved the prediction is skipped (the stress at the current positions decides).
 std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
                                const FractureParams& params, const FractureContext& context, CholeskySolver& solver,
-                               std::vector<FaceFractureStress>& stress, const std::vector<char>& refused,
-                               const SeparationOptions& options) {
+                               std::vector<FaceFractureStress>& stress, const std::vector<char>& refused) {
   std::vector<Vec3> saved;
   std::vector<int> moved;
   // The prediction starts from rest: with the nodes' velocities in it, x + dt dv would also carry -dt v (the
@@ -272,7 +263,7 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
   }
   for (size_t i = 0; i < still.size(); ++i) mesh.nodes[still[i]].v = velocities[i];
   update_fracture_stresses(mesh, materials, faces_of_nodes(mesh, zone), stress);
-  std::vector<Candidate> out = breaking_nodes(mesh, materials, zone, stress, refused, options);
+  std::vector<Candidate> out = breaking_nodes(mesh, materials, zone, stress, refused, params.separation);
   for (size_t i = 0; i < moved.size(); ++i) mesh.nodes[moved[i]].x = saved[i];
   return out;
 }
@@ -387,7 +378,7 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
       std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
       if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, pass, stats);
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
-      candidates = predict(mesh, materials, zone_nodes, params, context, zone_solver, stress, refused, params.separation);
+      candidates = predict(mesh, materials, zone_nodes, params, context, zone_solver, stress, refused);
       if (candidates.empty()) break;
       zone = open_candidates(mesh, materials, candidates, params, context, pass, refused, stats);
     }

@@ -36,6 +36,8 @@ struct ZoneSolveOptions {
 struct ZoneSolution {
   std::vector<int> nodes;          // the zone's live nodes (sorted)
   std::vector<Vec3> dv;            // velocity change (m/s), per node (0 for nodes the loads pin)
+  // v and x are the step's result (kStep) only: v + dv and x + dt (v + dv). With kNewtonFromRest the mesh's x
+  // already holds the iterate x_0 + dt v_k, so the caller forms x_0 + dt (v_k + dv) itself.
   std::vector<Vec3> v;             // new velocity (m/s)
   std::vector<Vec3> x;             // new position x + dt v (m)
   std::vector<int> support_nodes;  // fixed nodes around the zone that it reads (sorted, none of the zone's)

@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "mesh/mesh_stats.hpp"
 #include "remesh/remesh.hpp"
 #include "scene/scene.hpp"
 #include "sim/simulation.hpp"
@@ -33,13 +34,5 @@ RemeshStats refine_to_size_min(Cloth& cloth, const RemeshOptions& options);
 // dropped with its anchor.
 void remap_handles(std::vector<Handle>& handles, int cloth, const Mesh::Compaction& compaction);
 
-// Mesh size at a moment, for the per-frame log: live face and node counts and the min / median / max world
-// edge length (m), and the same for rest-space lengths.
-struct MeshSizeStats {
-  int faces = 0, nodes = 0, edges = 0;
-  double edge_min = 0, edge_median = 0, edge_max = 0;                 // world, m
-  double rest_edge_min = 0, rest_edge_median = 0, rest_edge_max = 0;  // rest space, m
-};
-MeshSizeStats mesh_size_stats(const Mesh& mesh);
 
 }  // namespace arcsim

@@ -29,6 +29,7 @@
 
 #include "collision/scene_fixtures.hpp"
 #include "mesh/edits.hpp"
+#include "mesh/mesh_stats.hpp"
 #include "mesh/validate.hpp"
 #include "support/mesh_factory.hpp"
 
@@ -379,17 +380,6 @@ struct BendingRun {
   int cracks_while_held = 0;  // openings during the hold steps
 };
 
-double median_rest_edge(const Mesh& mesh, double* shortest) {
-  std::vector<double> lengths;
-  for (const Face& f : mesh.faces) {
-    if (f.dead) continue;
-    for (int i = 0; i < 3; ++i) lengths.push_back((mesh.verts[f.v[(i + 1) % 3]].u - mesh.verts[f.v[i]].u).norm());
-  }
-  std::sort(lengths.begin(), lengths.end());
-  if (shortest) *shortest = lengths.front();
-  return lengths[lengths.size() / 2];
-}
-
 BendingRun bend_until_crack(double alpha, double kappa_rate, double max_kappa, int hold_steps) {
   StripSpec s;
   s.length = 0.1;
@@ -403,7 +393,7 @@ BendingRun bend_until_crack(double alpha, double kappa_rate, double max_kappa, i
   build(run, s);
   Simulation& sim = *run.sim;
   BendingRun out;
-  out.median_edge = median_rest_edge(sim.cloths[0].mesh, nullptr);
+  out.median_edge = mesh_size_stats(sim.cloths[0].mesh).rest_edge_median;
   for (int step = 1; step * kappa_rate <= max_kappa + 1e-12; ++step) {
     const double kappa = step * kappa_rate;
     const auto place = [&](const Vec3& u) { return on_arc(u, s.length, kappa); };
@@ -419,7 +409,7 @@ BendingRun bend_until_crack(double alpha, double kappa_rate, double max_kappa, i
   const Mesh& mesh = sim.cloths[0].mesh;
   EXPECT_EQ(check_mesh(mesh), "");
   out.pieces_at_onset = count_components(mesh);
-  median_rest_edge(mesh, &out.shortest_edge);
+  out.shortest_edge = mesh_size_stats(mesh).rest_edge_min;
   for (int step = 0; step < hold_steps; ++step) {
     sim.advance_step();  // the clamps stay where they are
     out.cracks_while_held += cracks_of_last_step(sim);
