@@ -210,4 +210,17 @@ std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vect
   return terms;
 }
 
+bool contact_term_at_gap_change(ContactTerm& term, double gap_change) {
+  if (!(term.stiffness > 0)) return false;
+  // repulsion_penalty: force = k d^2 / (2T), stiffness = k d / T, so d = 2 force / stiffness, k/T = stiffness / d.
+  const double depth = 2 * term.force / term.stiffness;
+  const double moved = depth - gap_change;
+  if (!(depth > 0) || !(moved > 0)) return false;
+  const double k_over_thickness = term.stiffness / depth;
+  term.force = 0.5 * k_over_thickness * moved * moved;
+  term.stiffness = k_over_thickness * moved;
+  term.outside_velocity = Vec3::Zero();
+  return true;
+}
+
 }  // namespace arcsim

@@ -49,6 +49,12 @@ Penalty repulsion_penalty(double gap, double k, double thickness);
 std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vector<ProximityContact>& contacts,
                                        int mesh, double thickness, double dt);
 
+// A contact term moved to a gap larger by `gap_change` (m) under the same penalty law (repulsion_penalty: the
+// depth is 2 force / stiffness), the other side at rest (outside_velocity 0). Returns false when the contact
+// has come apart (no depth left). Fracture's virtual update re-evaluates the step's contacts this way at the
+// step's end positions: the gaps were measured at its start.
+bool contact_term_at_gap_change(ContactTerm& term, double gap_change);
+
 // Damping coefficient c (kg/s) of the implicit friction force -c P u on the relative tangential velocity u_t
 // (m/s): c = mu f_n / |u_t|, so that a sliding contact feels exactly the Coulomb force, capped at
 // kStickFactor m_eff / dt (m_eff = 1 / sum_i w_i^2 / m_i) so that a sticking contact (u_t -> 0) stays

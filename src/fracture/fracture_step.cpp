@@ -6,6 +6,7 @@
 #include <iterator>
 #include <memory>
 
+#include "collision/proximity.hpp"
 #include "fracture/fracture_stress.hpp"
 #include "math/errors.hpp"
 #include "mesh/mesh_stats.hpp"
@@ -77,8 +78,43 @@ struct PassState {
   std::unique_ptr<WorldGuard> guard;
   TouchedNodes touched;
   double crack_scale = 0;  // m: the length the opening's snap and sliver limits scale with
+  ExternalLoads loads;     // the virtual update's loads: the context's, contacts at the step's end positions
   explicit PassState(const Mesh& mesh) : touched(mesh) {}
 };
+
+// The step's contacts at the positions the step ended at: each gap grows by the weighted displacement of its
+// nodes over the step (x - x0, which the collision response and the edits' reprojection keep) and by the other
+// side's motion (dt times its velocity); contacts that came apart are dropped.
+std::vector<ContactTerm> contacts_at_step_end(const Mesh& mesh, const std::vector<ContactTerm>& contacts,
+                                              double dt) {
+  std::vector<ContactTerm> out;
+  out.reserve(contacts.size());
+  const int node_count = static_cast<int>(mesh.nodes.size());
+  for (ContactTerm c : contacts) {
+    Vec3 displacement = dt * c.outside_velocity;
+    bool valid = true;
+    for (int i = 0; i < 4; ++i) {
+      const int n = c.nodes[i];
+      if (n == kNone) continue;
+      if (n < 0 || n >= node_count || mesh.nodes[n].dead) valid = false;
+      if (!valid) break;
+      displacement += c.weights[i] * (mesh.nodes[n].x - mesh.nodes[n].x0);
+    }
+    if (valid && contact_term_at_gap_change(c, c.normal.dot(displacement))) out.push_back(c);
+  }
+  return out;
+}
+
+// Contacts with a node that an edit of the pass removed no longer apply.
+void drop_dead_contacts(const Mesh& mesh, std::vector<ContactTerm>& contacts) {
+  contacts.erase(std::remove_if(contacts.begin(), contacts.end(),
+                                [&](const ContactTerm& c) {
+                                  for (int n : c.nodes)
+                                    if (n != kNone && mesh.nodes[n].dead) return true;
+                                  return false;
+                                }),
+                 contacts.end());
+}
 
 void refresh_masses(Mesh& mesh, const std::vector<Material>& materials, PassState& pass) {
   update_node_masses(mesh, materials, pass.touched.take());
@@ -213,8 +249,10 @@ std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials,
 // Steps 2c-d: the breaking nodes of the zone at the positions a zone step predicts, positions rewound. When the
 // zone's system cannot be solved the prediction is skipped (the stress at the current positions decides).
 std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
-                               const FractureParams& params, const FractureContext& context, CholeskySolver& solver,
-                               std::vector<FaceFractureStress>& stress, const std::vector<char>& refused) {
+                               const FractureParams& params, const FractureContext& context, PassState& pass,
+                               CholeskySolver& solver, std::vector<FaceFractureStress>& stress,
+                               const std::vector<char>& refused) {
+  drop_dead_contacts(mesh, pass.loads.contacts);
   std::vector<Vec3> saved;
   std::vector<int> moved;
   // The prediction starts from rest: with the nodes' velocities in it, x + dt dv would also carry -dt v (the
@@ -237,7 +275,7 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
     zone_options.linearisation = Linearisation::kNewtonFromRest;
     ZoneSolution sol;
     try {
-      sol = solve_zone(mesh, materials, zone, context.loads, context.dt, solver, zone_options);
+      sol = solve_zone(mesh, materials, zone, pass.loads, context.dt, solver, zone_options);
     } catch (const NumericalError&) {
       if (it == 0) moved.clear(), saved.clear();
       break;  // later iterations keep the last iterate
@@ -363,6 +401,8 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
 
   PassState pass(mesh);
   pass.crack_scale = crack_length_scale(mesh, context);
+  pass.loads = context.loads;
+  pass.loads.contacts = contacts_at_step_end(mesh, context.loads.contacts, context.dt);
   if (context.remesh.world_clearance > 0)
     pass.guard = std::make_unique<WorldGuard>(mesh, context.remesh.obstacles, context.remesh.world_clearance);
   if (!params.substepping) {
@@ -378,7 +418,7 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
       std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
       if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, pass, stats);
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
-      candidates = predict(mesh, materials, zone_nodes, params, context, zone_solver, stress, refused);
+      candidates = predict(mesh, materials, zone_nodes, params, context, pass, zone_solver, stress, refused);
       if (candidates.empty()) break;
       zone = open_candidates(mesh, materials, candidates, params, context, pass, refused, stats);
     }

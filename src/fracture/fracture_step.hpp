@@ -9,13 +9,17 @@
 //      b. local remesh of Z''s faces down to size_min (remesh/remesh.hpp with a face subset, uniform metric),
 //         so the crack opens at the finest resolution;
 //      c. virtual physics update of Z' (physics/zone_solve.hpp; a 1-ring support held fixed): one implicit
-//         step of the step's size with the step's gravity and handle springs (no contacts), started from
+//         step of the step's size with the step's gravity, handle springs and contacts, started from
 //         rest (v = 0 in the zone and its support); the nodes move by x + dt dv: that is the stress
 //         relaxation the opened cracks cause, not the step's motion, which the next full step makes (with the
 //         velocities in, dv would also carry -v in the stiff limit: measured on paper-tearing.json, predicted
 //         principal stresses at the notch turned by 60 degrees and tripled); the step is solved by Newton
 //         iterations (virtual_iterations), because one linearised step of a bent stiff sheet stretches it
-//         along tangents by order theta^2 / 2, more than glass's critical strain;
+//         along tangents by order theta^2 / 2, more than glass's critical strain. The contacts are the
+//         step's repulsions moved to its end positions (contact_term_at_gap_change): without them a crack tip
+//         in a fold of the sheet relaxed through the layer pressed against it (paper-tearing.json, t = 1.33 s:
+//         s / tau 4.2 at the tip, predicted 0 every step, so the ligament never tore while its stress grew
+//         to 7.6 tau; with them the prediction moves the tip 0.09 mm instead of 0.56 and it opens);
 //      d. s for Z''s nodes at the predicted positions, then positions rewound;
 //      e. the node with the largest s / tau opens (fracture/crack_opening.hpp, through one edit session):
 //         Z = the nodes of Z' with s > tau, minus the opened node, plus the new crack tips. A refused opening
@@ -69,7 +73,9 @@ struct FractureParams {
 // What the simulation hands to one fracture pass of a cloth.
 struct FractureContext {
   RemeshOptions remesh;  // the cloth's remeshing options (sizes, reference, reprojection, world guard)
-  ExternalLoads loads;   // gravity and handle springs at the step's time (contacts are ignored)
+  // Gravity and handle springs at the step's time, and the step's contacts as its implicit step had them (gaps
+  // measured at the step's start; the virtual update re-evaluates them at the step's end positions).
+  ExternalLoads loads;
   double dt = 0;         // s
 };
 

@@ -205,12 +205,12 @@ void Simulation::refresh_elements() {
   }
 }
 
-void Simulation::physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts) {
+void Simulation::physics_step(double dt) {
   refresh_elements();
   for (size_t c = 0; c < cloths.size(); ++c) {
     Cloth& cloth = cloths[c];
     ExternalLoads loads = loads_for(static_cast<int>(c), time_);
-    if (c < contacts.size()) loads.contacts = std::move(contacts[c]);
+    if (c < step_contacts_.size()) loads.contacts = step_contacts_[c];
     update_contact_pattern(cloth.elements, loads.contacts);
     implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads, dt, &times.solver);
   }
@@ -289,13 +289,13 @@ void Simulation::advance_step() {
   refresh_elements();
   audit(&StepEnergies::start);
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::vector<ContactTerm>> contacts;
-  if (scene_.enabled("proximity") && scene_.enabled("physics")) contacts = proximity_step(dt);
+  step_contacts_.clear();
+  if (scene_.enabled("proximity") && scene_.enabled("physics")) step_contacts_ = proximity_step(dt);
   times.collision += seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
   if (scene_.enabled("physics")) {
-    physics_step(dt, std::move(contacts));
+    physics_step(dt);
   } else {
     for (Cloth& cloth : cloths)
       for (Node& n : cloth.mesh.nodes) n.x0 = n.x;
@@ -405,6 +405,7 @@ void Simulation::fracture_step(double dt) {
     for (size_t other = 0; other < cloths.size(); ++other)
       if (other != c) context.remesh.obstacles.push_back(&cloths[other].mesh);
     context.loads = loads_for(static_cast<int>(c), time_);
+    if (c < step_contacts_.size()) context.loads.contacts = step_contacts_[c];
     const FractureStats s = arcsim::fracture_step(cloth.mesh, cloth.materials, params, context, cloth.zone_solver);
     fracture_stats[c] += s;
     topology_changed(static_cast<int>(c), s.edited);

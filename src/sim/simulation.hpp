@@ -151,7 +151,8 @@ class Simulation {
   CollisionSettings collision_settings() const;
   // Proximity terms per cloth (empty lists when the module is disabled).
   std::vector<std::vector<ContactTerm>> proximity_step(double dt);
-  void physics_step(double dt, std::vector<std::vector<ContactTerm>> contacts);
+  // The implicit step of every cloth with its loads and step_contacts_.
+  void physics_step(double dt);
   void collision_step(double dt);
   // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
   void jitter_step();
@@ -178,6 +179,9 @@ class Simulation {
   double end_time_ = kInfinity;
   double end_frame_ = kInfinity;
   CollisionHandler collisions_;
+  // This step's proximity terms per cloth: the implicit step's contacts, and the loads of fracture's virtual
+  // update (rebuilt every step; not part of the saved state).
+  std::vector<std::vector<ContactTerm>> step_contacts_;
 };
 
 }  // namespace arcsim
