@@ -53,6 +53,7 @@ std::vector<std::vector<ContactTerm>> CollisionHandler::proximity_terms(const st
 ImpactZoneStats CollisionHandler::resolve_collisions(const std::vector<Mesh*>& cloths,
                                                      const std::vector<const Mesh*>& obstacles,
                                                      const CollisionSettings& settings, double dt) {
+  fallback_nodes_.assign(cloths.size(), {});
   if (cloths.empty()) return {};
   const std::vector<const Mesh*> cloth_view(cloths.begin(), cloths.end());
   build_contact_geometry(bodies_of(cloth_view, obstacles), ContactStage::kAfterStep, dt, geometry_);
@@ -67,7 +68,9 @@ ImpactZoneStats CollisionHandler::resolve_collisions(const std::vector<Mesh*>& c
 
   for (size_t c = 0; c < cloths.size(); ++c) {
     Mesh& mesh = *cloths[c];
-    const int begin = geometry_.meshes[c].node_begin;
+    const int begin = geometry_.meshes[c].node_begin, end = geometry_.meshes[c].node_end;
+    for (int n : stats.fallback_nodes)
+      if (n >= begin && n < end) fallback_nodes_[c].push_back(n - begin);
     for (size_t i = 0; i < mesh.nodes.size(); ++i) {
       Node& n = mesh.nodes[i];
       const Vec3 moved = geometry_.x1[begin + i] - n.x;

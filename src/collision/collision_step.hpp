@@ -53,12 +53,17 @@ class CollisionHandler {
   ImpactZoneStats resolve_collisions(const std::vector<Mesh*>& cloths, const std::vector<const Mesh*>& obstacles,
                                      const CollisionSettings& settings, double dt);
 
+  // Per cloth (in the order given, local node indices, sorted): the nodes the last resolve_collisions moved by a
+  // fallback (rigid or held impact zones; ImpactZoneStats::fallback_nodes).
+  const std::vector<std::vector<int>>& fallback_nodes() const { return fallback_nodes_; }
+
   const BvhCache& bvh_cache() const { return cache_; }
   const ImpactZoneTotals& totals() const { return totals_; }
   void clear_totals() { totals_ = ImpactZoneTotals(); }
 
  private:
   ImpactZoneTotals totals_;
+  std::vector<std::vector<int>> fallback_nodes_;
   BvhCache cache_;
   ContactGeometry geometry_;
 };

@@ -211,8 +211,13 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       if (!z.alive || z.nodes.empty()) continue;
       ++stats.zones;
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(z.nodes.size()));
-      if (z.state != ZoneState::kProjected) ++stats.fallback_zones;
+      if (z.state == ZoneState::kProjected) continue;
+      ++stats.fallback_zones;
+      stats.fallback_nodes.insert(stats.fallback_nodes.end(), z.nodes.begin(), z.nodes.end());
     }
+    std::sort(stats.fallback_nodes.begin(), stats.fallback_nodes.end());
+    stats.fallback_nodes.erase(std::unique(stats.fallback_nodes.begin(), stats.fallback_nodes.end()),
+                               stats.fallback_nodes.end());
     return stats;
   };
 

@@ -52,6 +52,9 @@ struct ImpactZoneStats {
   int fallback_zones = 0;    // zones moved rigidly or held at x0
   int ill_conditioned_zones = 0;  // projections refused as ill-conditioned (those zones also count as fallback)
   bool resolved = true;      // the final motion is collision free
+  // Nodes (geometry indices, sorted) of the zones moved rigidly or held at x0: their end positions are not the
+  // physics' outcome, and the strain between them and their neighbours is not the material's.
+  std::vector<int> fallback_nodes;
 };
 
 // Moves the movable nodes' end positions g.x1 so that the motion is collision free.

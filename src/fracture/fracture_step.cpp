@@ -390,6 +390,12 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
 
   std::vector<FaceFractureStress> stress = fracture_stresses(mesh, materials);
   std::vector<char> refused(mesh.nodes.size(), 0);
+  if (!context.untrusted_nodes.empty()) {
+    std::vector<int> untrusted;
+    for (int n : context.untrusted_nodes)
+      if (n >= 0 && n < static_cast<int>(mesh.nodes.size()) && !mesh.nodes[n].dead) untrusted.push_back(n);
+    for (int n : node_rings(mesh, untrusted, 1)) refused[n] = 1;
+  }
   std::vector<Candidate> candidates =
       breaking_nodes(mesh, materials, live_nodes(mesh), stress, refused, params.separation);
   stats.candidates = static_cast<int>(candidates.size());

@@ -258,6 +258,7 @@ void Simulation::collision_step(double dt) {
   std::vector<Mesh*> cloth_meshes;
   for (Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
   collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
+  step_fallback_nodes_ = collisions_.fallback_nodes();
 }
 
 void Simulation::check_state() const {
@@ -290,6 +291,7 @@ void Simulation::advance_step() {
   audit(&StepEnergies::start);
   auto t0 = std::chrono::steady_clock::now();
   step_contacts_.clear();
+  step_fallback_nodes_.clear();
   if (scene_.enabled("proximity") && scene_.enabled("physics")) step_contacts_ = proximity_step(dt);
   times.collision += seconds_since(t0);
 
@@ -406,6 +408,7 @@ void Simulation::fracture_step(double dt) {
       if (other != c) context.remesh.obstacles.push_back(&cloths[other].mesh);
     context.loads = loads_for(static_cast<int>(c), time_);
     if (c < step_contacts_.size()) context.loads.contacts = step_contacts_[c];
+    context.untrusted_nodes = c < step_fallback_nodes_.size() ? step_fallback_nodes_[c] : std::vector<int>();
     const FractureStats s = arcsim::fracture_step(cloth.mesh, cloth.materials, params, context, cloth.zone_solver);
     fracture_stats[c] += s;
     topology_changed(static_cast<int>(c), s.edited);

@@ -182,6 +182,9 @@ class Simulation {
   // This step's proximity terms per cloth: the implicit step's contacts, and the loads of fracture's virtual
   // update (rebuilt every step; not part of the saved state).
   std::vector<std::vector<ContactTerm>> step_contacts_;
+  // This step's nodes per cloth that the collision response moved by a fallback (fracture does not trust
+  // their strain; FractureContext::untrusted_nodes).
+  std::vector<std::vector<int>> step_fallback_nodes_;
 };
 
 }  // namespace arcsim

@@ -60,6 +60,7 @@ TEST(ImpactZones, SheetPassingThroughPlateStopsAtTheGap) {
   const ImpactZoneStats stats = resolve_impacts(g, cache, params());
   EXPECT_TRUE(stats.resolved);
   EXPECT_EQ(stats.fallback_zones, 0);
+  EXPECT_TRUE(stats.fallback_nodes.empty());
   EXPECT_TRUE(detect_impacts(g, cache, params()).empty());
   EXPECT_EQ(intersections(g, 0, 1), 0);
   // The least mass-weighted correction: straight up to the projection gap, keeping the sideways motion.
@@ -190,6 +191,8 @@ TEST(ImpactZones, InfeasibleZoneFallsBackWithWarning) {
   EXPECT_GE(stats.fallback_zones, 1);
   EXPECT_TRUE(stats.resolved);
   for (int n = 0; n < 4; ++n) EXPECT_EQ(g.x1[n], g.x0[n]);
+  // The held nodes are reported (fracture does not trust their strain), the plates' are not.
+  EXPECT_EQ(stats.fallback_nodes, (std::vector<int>{0, 1, 2, 3}));
 }
 
 }  // namespace

@@ -54,6 +54,28 @@ TEST(Proximity, PenaltyIsTheDerivativeOfTheCubicEnergy) {
   EXPECT_EQ(repulsion_penalty(2 * kT, k, kT).stiffness, 0.0);
 }
 
+TEST(Proximity, ContactTermAtAGapChangeFollowsThePenaltyLaw) {
+  const double k = 2e5;
+  for (double gap : {-2e-4, 0.0, 3e-4, 9e-4}) {
+    for (double change : {-3e-4, -1e-5, 0.0, 5e-5, 4e-4}) {
+      const Penalty p = repulsion_penalty(gap, k, kT);
+      ContactTerm term;
+      term.force = p.force;
+      term.stiffness = p.stiffness;
+      term.outside_velocity = Vec3(0.1, 0.2, 0.3);
+      const Penalty expected = repulsion_penalty(gap + change, k, kT);
+      const bool touching = contact_term_at_gap_change(term, change);
+      EXPECT_EQ(touching, expected.stiffness > 0) << gap << " " << change;
+      if (!touching) continue;
+      EXPECT_NEAR(term.force, expected.force, 1e-9 * expected.force + 1e-15) << gap << " " << change;
+      EXPECT_NEAR(term.stiffness, expected.stiffness, 1e-9 * expected.stiffness) << gap << " " << change;
+      EXPECT_EQ(term.outside_velocity, Vec3::Zero());  // the other side is at rest in the re-evaluated term
+    }
+  }
+  ContactTerm none;  // a term without stiffness (no depth) never touches
+  EXPECT_FALSE(contact_term_at_gap_change(none, -1e-4));
+}
+
 TEST(Proximity, FrictionDampingIsCoulombWhileSlidingAndCappedWhenSticking) {
   const double m = 1e-3, dt = 1e-3;
   // Sliding fast: the force c |u_t| is mu f_n.
