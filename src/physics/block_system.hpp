@@ -19,6 +19,11 @@
 
 namespace arcsim {
 
+// Sorts `pairs` as std::sort does (by first, then second) and drops duplicates. Counting sort by first over
+// [0, key_count), then each (small) bucket by second: topology changes sort ~50k node pairs per step. Falls back
+// to std::sort if a first is out of range.
+void sort_unique_pairs(std::vector<std::pair<int, int>>& pairs, int key_count);
+
 class BlockPattern {
  public:
   // Builds the pattern for `node_count` nodes from the node pairs that interact (any order, duplicates fine;
