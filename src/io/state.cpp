@@ -23,13 +23,22 @@ namespace arcsim {
 // ---------------------------------------------------------------------------------------------------------
 // Byte encoding
 
-void StateWriter::put_u32(uint32_t value) {
-  for (int i = 0; i < 4; ++i) put_u8(static_cast<uint8_t>(value >> (8 * i)));
+namespace {
+
+// Little-endian bytes of the low N bytes of `value`, built in a local array and appended at once (a push_back
+// per byte dominated saving large meshes).
+template <int N>
+void append_le(std::string& out, uint64_t value) {
+  char bytes[N];
+  for (int i = 0; i < N; ++i) bytes[i] = static_cast<char>(static_cast<uint8_t>(value >> (8 * i)));
+  out.append(bytes, N);
 }
 
-void StateWriter::put_u64(uint64_t value) {
-  for (int i = 0; i < 8; ++i) put_u8(static_cast<uint8_t>(value >> (8 * i)));
-}
+}  // namespace
+
+void StateWriter::put_u32(uint32_t value) { append_le<4>(bytes_, value); }
+
+void StateWriter::put_u64(uint64_t value) { append_le<8>(bytes_, value); }
 
 void StateWriter::put_f64(double value) {
   static_assert(sizeof(double) == sizeof(uint64_t), "IEEE-754 binary64 expected");
@@ -168,6 +177,11 @@ void read_clock(StateReader& r, StagedState& s) {
 }
 
 void write_mesh(const Mesh& m, StateWriter& w) {
+  // Exact size on a consistent mesh: every vert sits in one node's list, every edge in two, every face in
+  // three verts' lists.
+  const size_t V = m.verts.size(), E = m.edges.size(), F = m.faces.size();
+  w.reserve(4 * 4 + m.nodes.size() * kNodeBytes + V * kVertBytes + E * kEdgeBytes + F * kFaceBytes +
+            4 * (V + 2 * E + 3 * F));
   w.put_count(m.nodes.size());
   for (const Node& n : m.nodes) {
     w.put_matrix(n.x);
@@ -281,6 +295,7 @@ void read_cloths(StateReader& r, StagedState& s) {
 void write_obstacles(const Simulation& sim, StateWriter& w) {
   w.put_count(sim.obstacles.size());
   for (const Obstacle& o : sim.obstacles) {
+    w.reserve(4 + o.mesh.nodes.size() * kObstacleNodeBytes + 1);
     w.put_count(o.mesh.nodes.size());
     for (const Node& n : o.mesh.nodes) {
       w.put_matrix(n.x);
@@ -493,13 +508,9 @@ void commit(StagedState& s, Simulation& sim) {
 // ---------------------------------------------------------------------------------------------------------
 // Envelope: header, section table, checksum
 
-void append_u32(std::string& out, uint32_t value) {
-  for (int i = 0; i < 4; ++i) out += static_cast<char>(static_cast<uint8_t>(value >> (8 * i)));
-}
+void append_u32(std::string& out, uint32_t value) { append_le<4>(out, value); }
 
-void append_u64(std::string& out, uint64_t value) {
-  for (int i = 0; i < 8; ++i) out += static_cast<char>(static_cast<uint8_t>(value >> (8 * i)));
-}
+void append_u64(std::string& out, uint64_t value) { append_le<8>(out, value); }
 
 uint32_t decode_u32(const char* p) {
   uint32_t value = 0;

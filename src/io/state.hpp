@@ -65,6 +65,8 @@ class StateWriter {
   void put_count(size_t count);
   void put_int_list(const std::vector<int>& values);
   void put_bytes(const char* data, size_t size) { bytes_.append(data, size); }
+  // Makes room for `extra` more bytes, sparing the regrowth of a large payload.
+  void reserve(size_t extra) { bytes_.reserve(bytes_.size() + extra); }
   const std::string& bytes() const { return bytes_; }
   std::string take() { return std::move(bytes_); }
 

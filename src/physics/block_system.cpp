@@ -11,24 +11,39 @@ namespace {
 std::atomic<uint64_t> next_pattern_id{1};
 }
 
+void sort_unique_pairs(std::vector<std::pair<int, int>>& pairs, int key_count) {
+  const bool in_range = std::all_of(pairs.begin(), pairs.end(),
+                                    [&](const auto& p) { return p.first >= 0 && p.first < key_count; });
+  if (!in_range) {
+    std::sort(pairs.begin(), pairs.end());
+  } else {
+    std::vector<int> start(key_count + 1, 0);
+    for (const auto& p : pairs) ++start[p.first + 1];
+    for (int k = 0; k < key_count; ++k) start[k + 1] += start[k];
+    std::vector<int> next(start.begin(), start.end() - 1);
+    std::vector<std::pair<int, int>> sorted(pairs.size());
+    for (const auto& p : pairs) sorted[next[p.first]++] = p;
+    for (int k = 0; k < key_count; ++k) std::sort(sorted.begin() + start[k], sorted.begin() + start[k + 1]);
+    pairs.swap(sorted);
+  }
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
 void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs) {
   node_count_ = node_count;
+  // Held as (col, row) with row >= col, so that sorting them gives column-major order: by column, then row.
   for (auto& p : pairs)
-    if (p.first < p.second) std::swap(p.first, p.second);  // (row, col) with row >= col
+    if (p.first > p.second) std::swap(p.first, p.second);
   for (int i = 0; i < node_count; ++i) pairs.emplace_back(i, i);
-  // Column-major order: by column, then row.
-  std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) {
-    return a.second != b.second ? a.second < b.second : a.first < b.first;
-  });
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  sort_unique_pairs(pairs, node_count);
 
   block_row_.resize(pairs.size());
   block_col_.resize(pairs.size());
   col_start_.assign(node_count + 1, 0);
   for (size_t k = 0; k < pairs.size(); ++k) {
-    block_row_[k] = pairs[k].first;
-    block_col_[k] = pairs[k].second;
-    ++col_start_[pairs[k].second + 1];
+    block_row_[k] = pairs[k].second;
+    block_col_[k] = pairs[k].first;
+    ++col_start_[pairs[k].first + 1];
   }
   for (int c = 0; c < node_count; ++c) col_start_[c + 1] += col_start_[c];
 

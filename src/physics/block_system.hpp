@@ -19,6 +19,11 @@
 
 namespace arcsim {
 
+// Sorts `pairs` as std::sort does (by first, then second) and drops duplicates. Counting sort by first over
+// [0, key_count), then each (small) bucket by second: topology changes sort ~50k node pairs per step. Falls back
+// to std::sort if a first is out of range.
+void sort_unique_pairs(std::vector<std::pair<int, int>>& pairs, int key_count);
+
 class BlockPattern {
  public:
   // Builds the pattern for `node_count` nodes from the node pairs that interact (any order, duplicates fine;
@@ -28,6 +33,8 @@ class BlockPattern {
   int block_count() const { return static_cast<int>(block_row_.size()); }
   // Index of block (i, j) (either order); -1 if not in the pattern.
   int block_index(int i, int j) const;
+  // Index of diagonal block (i, i): build puts it first in its column, as no row of column i is below i.
+  int diagonal_block(int i) const { return col_start_[i]; }
   // Identifies the pattern: equal ids mean identical structure (symbolic factorisation can be reused).
   uint64_t id() const { return id_; }
 
@@ -71,10 +78,13 @@ struct BlockSystem {
 // fixed, see physics/system_dofs.hpp).
 template <int N>
 std::array<int, N * N> element_block_ids(const BlockPattern& p, const std::array<int, N>& rows) {
+  // Ids are symmetric, and a diagonal block needs no search: search each a < b once and copy.
   std::array<int, N * N> ids{};
-  for (int a = 0; a < N; ++a)
-    for (int b = 0; b < N; ++b)
-      ids[a * N + b] = (rows[a] < 0 || rows[b] < 0) ? -1 : p.block_index(rows[a], rows[b]);
+  for (int a = 0; a < N; ++a) {
+    ids[a * N + a] = rows[a] < 0 ? -1 : p.diagonal_block(rows[a]);
+    for (int b = a + 1; b < N; ++b)
+      ids[a * N + b] = ids[b * N + a] = (rows[a] < 0 || rows[b] < 0) ? -1 : p.block_index(rows[a], rows[b]);
+  }
   return ids;
 }
 

@@ -21,13 +21,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // (row >= col) pairs without diagonal entries, sorted and unique.
-std::vector<std::pair<int, int>> sorted_node_pairs(std::vector<std::pair<int, int>> pairs) {
+std::vector<std::pair<int, int>> sorted_node_pairs(std::vector<std::pair<int, int>> pairs, int node_count) {
   for (auto& p : pairs)
     if (p.first < p.second) std::swap(p.first, p.second);
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [](const auto& p) { return p.first == p.second; }),
               pairs.end());
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  sort_unique_pairs(pairs, node_count);
   return pairs;
 }
 
@@ -84,7 +83,7 @@ void build_element_cache(const Mesh& mesh, const std::vector<Material>& material
         if (b.nodes[i] != b.nodes[j]) pairs.emplace_back(b.nodes[i], b.nodes[j]);
   }
 
-  std::vector<std::pair<int, int>> element_pairs = sorted_node_pairs(std::move(pairs));
+  std::vector<std::pair<int, int>> element_pairs = sorted_node_pairs(std::move(pairs), static_cast<int>(mesh.nodes.size()));
   cache.node_mass.resize(mesh.nodes.size());
   for (size_t n = 0; n < mesh.nodes.size(); ++n) cache.node_mass[n] = mesh.nodes[n].mass;
   // Same connectivity (only rest state, thickness or plasticity changed): keep the pattern and its contact
@@ -107,7 +106,7 @@ bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>&
       for (int b = 0; b < a; ++b)
         if (c.nodes[a] != kNone && c.nodes[b] != kNone && c.nodes[a] != c.nodes[b])
           needed.emplace_back(c.nodes[a], c.nodes[b]);
-  needed = sorted_node_pairs(std::move(needed));
+  needed = sorted_node_pairs(std::move(needed), static_cast<int>(cache.node_mass.size()));
   std::vector<std::pair<int, int>> extra;
   std::set_difference(needed.begin(), needed.end(), cache.element_pairs.begin(), cache.element_pairs.end(),
                       std::back_inserter(extra));
