@@ -77,8 +77,9 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
     if (n >= 0 && n < node_count && !mesh.nodes[n].dead) out.nodes.push_back(n);
   sort_unique(out.nodes);
   std::vector<int> free_nodes;
+  // Nodes past the end of `pinned` were added by edits after the loads were made (fracture's openings): free.
   for (int n : out.nodes)
-    if (loads.pinned.empty() || !loads.pinned[n]) free_nodes.push_back(n);
+    if (n >= static_cast<int>(loads.pinned.size()) || !loads.pinned[n]) free_nodes.push_back(n);
   const SystemDofs dofs = SystemDofs::only(free_nodes);
   const size_t count = out.nodes.size();
   out.dv.assign(count, Vec3::Zero());

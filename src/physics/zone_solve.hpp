@@ -47,7 +47,8 @@ struct ZoneSolution {
 
 // One implicit step of size dt (s) over `zone_nodes` (any order; duplicates and dead nodes ignored) with the
 // loads of the full step (gravity, wind, handle springs on zone nodes, contacts touching the zone). Zone nodes
-// the loads pin keep their velocity (dv = 0) and are not rows of the system, as in the full step. Nodes outside
+// the loads pin keep their velocity (dv = 0) and are not rows of the system, as in the full step (nodes past
+// the end of loads.pinned, added by edits after the loads were made, are free). Nodes outside
 // the zone are not advanced. Leaves the mesh untouched. An empty zone gives an empty solution. Throws
 // NumericalError if the zone's system cannot be factorised or the result is not finite.
 ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials,
