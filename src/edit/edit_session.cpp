@@ -431,14 +431,15 @@ bool EditSession::reproject(int node) {
 
 bool EditSession::move_node(int node, const Vec3& displacement) { return move_node(node, displacement, {}); }
 
-bool EditSession::move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces) {
+bool EditSession::move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces,
+                            bool require_clearance) {
   Node& n = m_.nodes[node];
   const Vec3 x = n.x, x0 = n.x0;
   std::vector<GuardTriangle> before;
   if (guard_) before = guard_->fan(node);
   n.x += displacement;
   n.x0 += displacement;
-  return keep_move(node, before, x, x0, exempt_faces);
+  return keep_move(node, before, x, x0, exempt_faces, require_clearance);
 }
 
 bool EditSession::reproject_unchecked(int node) {
@@ -454,9 +455,17 @@ bool EditSession::reproject_unchecked(int node) {
 // After `node` moved from (x, x0), where its faces were `before`: keeps the move if the guard allows it (and
 // indexes the moved faces), else puts the node back. True if the move stays.
 bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
-                            const std::vector<int>& exempt_faces) {
+                            const std::vector<int>& exempt_faces, bool require_clearance) {
   if (!guard_) return true;
-  if (m_.nodes[node].x != x && !guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), exempt_faces)) {
+  auto allowed = [&] {
+    if (!require_clearance) {
+      std::vector<int> sorted = exempt_faces;
+      std::sort(sorted.begin(), sorted.end());
+      return guard_->sweep_is_clear(guard_->fan_sweep(node, x), sorted);
+    }
+    return guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), exempt_faces);
+  };
+  if (m_.nodes[node].x != x && !allowed()) {
     m_.nodes[node].x = x;
     m_.nodes[node].x0 = x0;
     ++counts_.guarded;

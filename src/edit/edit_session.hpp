@@ -126,8 +126,11 @@ class EditSession {
   // the move was kept. For small moves an edit needs (fracture: the lips of a new crack set apart).
   bool move_node(int node, const Vec3& displacement);
   // The same, but the guard does not check the move against `exempt_faces` (a crack's lips, which start
-  // coincident: any move of one lip touches the other).
-  bool move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces);
+  // coincident: any move of one lip touches the other). With require_clearance false, the guard only checks
+  // that the moving faces sweep through nothing: the move may end closer to a surface than the clearance (a
+  // lip set apart next to the lip of an earlier crack; collision handling keeps the two apart from then on).
+  bool move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces,
+                 bool require_clearance = true);
 
   void add_observer(EditObserver* observer) { observers_.push_back(observer); }
 
@@ -166,7 +169,7 @@ class EditSession {
   bool reproject_unchecked(int node);
   // kGuardMoves
   bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
-                 const std::vector<int>& exempt_faces = {});
+                 const std::vector<int>& exempt_faces = {}, bool require_clearance = true);
   GuardTriangle world_triangle(std::array<int, 3> nodes) const;
   GuardTriangle face_triangle(int f) const;
 

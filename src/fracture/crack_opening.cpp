@@ -203,9 +203,10 @@ int piece_faces(const Mesh& m, int start, const std::vector<int>& cut, int limit
 
 // Moves a node of a new crack by `distance` (m) away from the other side(s) of the split, `twins` (the split
 // node and its copies): along its own faces' centroid minus the centroid of all the copies' faces, within its
-// faces' mean world plane. The guard does not check the move against the twins' faces, which it touches by
-// construction.
-void set_lip_apart(EditSession& session, int node, double distance, const std::vector<int>& twins) {
+// faces' mean world plane. The guard does not check the move against the faces of `split` (every node the
+// opening split, and their copies), which it touches by construction: they start coincident with its own.
+void set_lip_apart(EditSession& session, int node, double distance, const std::vector<int>& twins,
+                   const std::vector<int>& split) {
   const Mesh& m = session.mesh();
   auto centroid_of = [&](const std::vector<int>& faces) {
     Vec3 c = Vec3::Zero();
@@ -218,7 +219,10 @@ void set_lip_apart(EditSession& session, int node, double distance, const std::v
   for (int t : twins) {
     const std::vector<int> faces = m.node_faces(t);
     all.insert(all.end(), faces.begin(), faces.end());
-    if (t != node) exempt.insert(exempt.end(), faces.begin(), faces.end());
+  }
+  for (int t : split) {
+    for (int f : m.node_faces(t))
+      if (std::find(own.begin(), own.end(), f) == own.end()) exempt.push_back(f);
   }
   if (own.empty() || all.empty()) return;
   Vec3 normal = Vec3::Zero();
@@ -226,7 +230,11 @@ void set_lip_apart(EditSession& session, int node, double distance, const std::v
   Vec3 d = centroid_of(own) - centroid_of(all);
   if (normal.norm() > 0) d -= d.dot(normal.normalized()) * normal.normalized();
   if (!(d.norm() > 0)) return;
-  session.move_node(node, distance * d.normalized(), exempt);
+  // The guard's clearance first. A lip next to the lip of an earlier crack (the same node split twice in a
+  // step, paper-tearing.json step 1128) cannot keep it: those lips are only a lip gap apart. Coincident twins
+  // are worse than lips closer than the clearance, so then only sweeping through a surface is ruled out.
+  const Vec3 move = distance * d.normalized();
+  if (!session.move_node(node, move, exempt)) session.move_node(node, move, exempt, false);
 }
 
 }  // namespace
@@ -259,10 +267,10 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
     if (m.edges[e].is_boundary()) return refuse(out, "the crack would follow an edge that already is a border");
 
   // A far end already on a border is split with the node (the crack reached it); the others are the new tips.
-  std::vector<int> tips;
+  std::vector<int> tips, split_far_ends;
   for (int e : out.crack_edges) {
     const int far = far_end(m, e, node);
-    if (!m.is_boundary_node(far)) tips.push_back(far);
+    (m.is_boundary_node(far) ? split_far_ends : tips).push_back(far);
   }
   if (options.min_piece_faces > 1)
     for (int f : m.node_faces(node))
@@ -275,10 +283,27 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
   const size_t copies = boundary && out.crack_edges.size() == 2 ? 2 : 1;
   out.nodes.push_back(node);
   for (size_t k = 0; k < copies && k < r.added_nodes.size(); ++k) out.nodes.push_back(r.added_nodes[k]);
+  // The far ends' copies follow (split_node copies x exactly: each copy is matched to its far end by position).
+  for (size_t k = copies; k < r.added_nodes.size(); ++k) {
+    const int copy = r.added_nodes[k];
+    for (int far : split_far_ends)
+      if (m.nodes[far].x == m.nodes[copy].x) {
+        out.far_ends.push_back({far, copy});
+        break;
+      }
+  }
   out.tips = tips;
   out.ok = true;
-  if (options.lip_gap > 0)
-    for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap, out.nodes);
+  if (options.lip_gap > 0) {
+    // A far end the crack reached on a border is split too, and its halves start just as coincident.
+    std::vector<int> split = out.nodes;
+    for (const std::array<int, 2>& twins : out.far_ends) split.insert(split.end(), twins.begin(), twins.end());
+    for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap, out.nodes, split);
+    for (const std::array<int, 2>& twins : out.far_ends) {
+      const std::vector<int> pair(twins.begin(), twins.end());
+      for (int n : pair) set_lip_apart(session, n, 0.5 * options.lip_gap, pair, split);
+    }
+  }
   return out;
 }
 

@@ -34,6 +34,7 @@
 // that were interior) are not touched: a driver that wants them kept by remeshing marks them itself.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -68,7 +69,10 @@ struct CrackOpening {
   std::vector<int> tips;         // far ends of the crack edges that were interior: the new crack tips (now on a
                                  // crack lip), candidates next substep; far ends already on a border are split
                                  // with the node instead (the crack reached the border) and are not tips
-  std::vector<int> nodes;        // the split node and the copies split_node made
+  std::vector<int> nodes;        // the split node and its copies
+  // Far ends already on a border that split_node split with the node: {far end, its copy}. Their halves are
+  // set lip_gap apart like the node's (coincident halves have no contact normal: paper-tearing.json, step 966).
+  std::vector<std::array<int, 2>> far_ends;
   int edge_splits = 0, snaps = 0;
   bool mesh_changed = false;     // an edit succeeded (true when ok; see above for when it is true and !ok)
 };

@@ -180,6 +180,39 @@ TEST(CrackOpening, LipsStartApartWithTheWorldGuardOn) {
   }
 }
 
+// A crack that reaches the border splits its far end too; those halves start apart like the node's (they did
+// not: paper-tearing.json, step 966, left two coincident border nodes whose contact had no normal, and every
+// impact zone around them fell back to holding at x0 from then on).
+TEST(CrackOpening, AFarEndOnTheBorderIsSplitIntoHalvesThatStartApart) {
+  Mesh mesh = make_grid(6, 4, 1.2, 0.8, Diagonal::kAlternating);
+  std::vector<Material> materials{testing::aluminium_sheet(1.0)};
+  for (Face& f : mesh.faces) f.thickness = materials[0].thickness;
+  EditSessionOptions o;
+  o.world_clearance = 1e-6;
+  EditSession session(mesh, materials, o);
+  CrackOpeningOptions c = options_with_size(0.2);
+  c.lip_gap = 2e-5;
+  const int node = test::grid_node(6, 3, 3);  // (0.6, 0.6): one row below the top border
+  const std::vector<CutRay> rays{ray_along(mesh, node, Vec3(0, 1, 0)), ray_along(mesh, node, Vec3(0, -1, 0))};
+  const CrackOpening opening = open_crack(session, node, rays, c);
+  ASSERT_TRUE(opening.ok) << opening.refused;
+  EXPECT_EQ(check_mesh(mesh), "");
+  ASSERT_EQ(opening.far_ends.size(), 1u);
+  const int far = opening.far_ends[0][0], copy = opening.far_ends[0][1];
+  EXPECT_NEAR(rest_of(mesh, far).y(), 0.8, 1e-12);
+  EXPECT_NEAR(rest_of(mesh, copy).y(), 0.8, 1e-12);
+  const Vec3 gap = mesh.nodes[copy].x - mesh.nodes[far].x;
+  EXPECT_NEAR(gap.norm(), c.lip_gap, 1e-3 * c.lip_gap);
+  EXPECT_NEAR(gap.z(), 0, 1e-12) << "the halves move within the sheet's plane";
+  // No two live nodes of the mesh coincide after the opening.
+  double closest = kInfinity;
+  for (size_t i = 0; i < mesh.nodes.size(); ++i)
+    for (size_t j = i + 1; j < mesh.nodes.size(); ++j)
+      if (!mesh.nodes[i].dead && !mesh.nodes[j].dead)
+        closest = std::min(closest, (mesh.nodes[i].x - mesh.nodes[j].x).norm());
+  EXPECT_GT(closest, 0.7 * c.lip_gap);
+}
+
 TEST(CrackOpening, InteriorCutAtAnAngleSplitsTheOppositeEdgesOnThePlane) {
   // Forward diagonals: a ray 20 degrees off the vertical leaves through a face whose opposite edge is a row.
   Sheet s(make_grid(6, 4, 1.2, 0.8, Diagonal::kForward));
