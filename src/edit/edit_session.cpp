@@ -4,6 +4,8 @@
 #include <utility>
 
 #include "mesh/validate.hpp"
+#include "physics/face_element.hpp"
+#include "physics/membrane.hpp"
 
 namespace arcsim {
 
@@ -32,6 +34,24 @@ Mat3 rest_to_world_map(const Mesh& m, int f) {
   Dx << x1 - x0, x2 - x0, nx.normalized();
   const Mat3 map = Dx * Du.inverse();
   return map.allFinite() ? map : Mat3::Identity();
+}
+
+// The face's total deformation gradient (world from its rest frame, 3x2; plasticity not included).
+Mat32 face_deformation_gradient(const Mesh& m, int f) {
+  return membrane_deformation_gradient(m.nodes[m.face_node(f, 0)].x, m.nodes[m.face_node(f, 1)].x,
+                                       m.nodes[m.face_node(f, 2)].x, m.faces[f].Dm_inv);
+}
+
+// After the face's deformation gradient went from `before` to `after`: its plastic stretch takes the change, so
+// that the elastic deformation after * P' equals before * P (P = the in-plane plastic stretch; least squares
+// when the face also turned out of its plane). Fp changes only in the rest frame's plane.
+void keep_elastic_deformation(Face& face, const Mat32& before, const Mat32& after) {
+  const Mat2 P = face_plastic_stretch_2d(face);
+  const Mat2 normal_matrix = after.transpose() * after;
+  if (!(normal_matrix.determinant() > 0)) return;
+  const Mat2 P_new = normal_matrix.ldlt().solve(after.transpose() * before * P);
+  if (!P_new.allFinite() || !(P_new.determinant() > 0)) return;
+  face.Fp += face.rest_frame * (P_new - P) * face.rest_frame.transpose();
 }
 
 void shift_node(Node& node, const Vec3& shift) {
@@ -429,17 +449,19 @@ bool EditSession::reproject(int node) {
   return reproject_unchecked(node);
 }
 
-bool EditSession::move_node(int node, const Vec3& displacement) { return move_node(node, displacement, {}); }
-
-bool EditSession::move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces,
-                            bool require_clearance) {
+bool EditSession::move_node(int node, const Vec3& displacement, const NodeMoveOptions& options) {
   Node& n = m_.nodes[node];
   const Vec3 x = n.x, x0 = n.x0;
   std::vector<GuardTriangle> before;
   if (guard_) before = guard_->fan(node);
+  std::vector<std::pair<int, Mat32>> deformation;  // the faces' total deformation gradients before the move
+  if (options.stress_free)
+    for (int f : m_.node_faces(node)) deformation.emplace_back(f, face_deformation_gradient(m_, f));
   n.x += displacement;
   n.x0 += displacement;
-  return keep_move(node, before, x, x0, exempt_faces, require_clearance);
+  if (!keep_move(node, before, x, x0, options)) return false;
+  for (const auto& [f, F] : deformation) keep_elastic_deformation(m_.faces[f], F, face_deformation_gradient(m_, f));
+  return true;
 }
 
 bool EditSession::reproject_unchecked(int node) {
@@ -455,15 +477,15 @@ bool EditSession::reproject_unchecked(int node) {
 // After `node` moved from (x, x0), where its faces were `before`: keeps the move if the guard allows it (and
 // indexes the moved faces), else puts the node back. True if the move stays.
 bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
-                            const std::vector<int>& exempt_faces, bool require_clearance) {
+                            const NodeMoveOptions& options) {
   if (!guard_) return true;
   auto allowed = [&] {
-    if (!require_clearance) {
-      std::vector<int> sorted = exempt_faces;
+    if (!options.require_clearance) {
+      std::vector<int> sorted = options.exempt_faces;
       std::sort(sorted.begin(), sorted.end());
       return guard_->sweep_is_clear(guard_->fan_sweep(node, x), sorted);
     }
-    return guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), exempt_faces);
+    return guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), options.exempt_faces);
   };
   if (m_.nodes[node].x != x && !allowed()) {
     m_.nodes[node].x = x;

@@ -102,6 +102,23 @@ struct EditCounts {
   double plastic_seconds = 0;   // wall time of the plastic transfer (capture, placement, rebuild), s
 };
 
+// How EditSession::move_node checks and books a move.
+struct NodeMoveOptions {
+  // Faces the guard does not check the move against (a crack's lips, which start coincident: any move of one
+  // lip touches the other).
+  std::vector<int> exempt_faces;
+  // False: the guard only checks that the moving faces sweep through nothing, and the move may end closer to a
+  // surface than the clearance (a lip set apart next to the lip of an earlier crack; collision handling keeps
+  // the two apart from then on).
+  bool require_clearance = true;
+  // True: the move strains nothing. Each face of the node takes the move into its plastic stretch Fp so that its
+  // elastic deformation F Fp stays what it was (mass and rest shape untouched). WHY: a crack's lips are set
+  // apart by a gap the collision stage needs (twice the projection thickness, 2e-5 m in ARCSim's scenes), and
+  // over glass's 1 mm faces that gap is a 1% strain, 25 times glass's critical strain: every opening of
+  // sphere-break.json added elastic energy (72 J in one step) and its stress cracked the lips' neighbours.
+  bool stress_free = false;
+};
+
 class EditSession {
  public:
   // `zone`: the faces the client works on (nullptr: the whole mesh). The mesh and materials must outlive the
@@ -124,13 +141,7 @@ class EditSession {
 
   // Moves a node (and its start-of-step position x0) by `displacement` (m) through the world guard; true if
   // the move was kept. For small moves an edit needs (fracture: the lips of a new crack set apart).
-  bool move_node(int node, const Vec3& displacement);
-  // The same, but the guard does not check the move against `exempt_faces` (a crack's lips, which start
-  // coincident: any move of one lip touches the other). With require_clearance false, the guard only checks
-  // that the moving faces sweep through nothing: the move may end closer to a surface than the clearance (a
-  // lip set apart next to the lip of an earlier crack; collision handling keeps the two apart from then on).
-  bool move_node(int node, const Vec3& displacement, const std::vector<int>& exempt_faces,
-                 bool require_clearance = true);
+  bool move_node(int node, const Vec3& displacement, const NodeMoveOptions& options = {});
 
   void add_observer(EditObserver* observer) { observers_.push_back(observer); }
 
@@ -169,7 +180,7 @@ class EditSession {
   bool reproject_unchecked(int node);
   // kGuardMoves
   bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
-                 const std::vector<int>& exempt_faces = {}, bool require_clearance = true);
+                 const NodeMoveOptions& options = {});
   GuardTriangle world_triangle(std::array<int, 3> nodes) const;
   GuardTriangle face_triangle(int f) const;
 

@@ -233,8 +233,15 @@ void set_lip_apart(EditSession& session, int node, double distance, const std::v
   // The guard's clearance first. A lip next to the lip of an earlier crack (the same node split twice in a
   // step, paper-tearing.json step 1128) cannot keep it: those lips are only a lip gap apart. Coincident twins
   // are worse than lips closer than the clearance, so then only sweeping through a surface is ruled out.
+  // The gap is taken up plastically by the lip's faces (NodeMoveOptions::stress_free): it is room for the
+  // collision stage, not a strain of the material.
   const Vec3 move = distance * d.normalized();
-  if (!session.move_node(node, move, exempt)) session.move_node(node, move, exempt, false);
+  NodeMoveOptions options;
+  options.exempt_faces = std::move(exempt);
+  options.stress_free = true;
+  if (session.move_node(node, move, options)) return;
+  options.require_clearance = false;
+  session.move_node(node, move, options);
 }
 
 }  // namespace

@@ -320,6 +320,7 @@ void Simulation::advance_step() {
   t0 = std::chrono::steady_clock::now();
   fracture_step(dt);
   times.fracture += seconds_since(t0);
+  audit(&StepEnergies::after_fracture, true);
 
   if (step_ % frame_steps_ == 0) {
     t0 = std::chrono::steady_clock::now();
@@ -327,6 +328,7 @@ void Simulation::advance_step() {
     times.remeshing += seconds_since(t0);
     ++frame_;
   }
+  audit(&StepEnergies::after_remeshing, true);
 }
 
 void Simulation::audit(double StepEnergies::*phase, bool fresh_elements) {

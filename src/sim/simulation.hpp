@@ -58,9 +58,12 @@ struct Handle {
 // last step, when Simulation::audit_energy is on. The differences are the work of each phase:
 // after_physics - start is what the implicit solve added (contact penalties, air; minus damping),
 // after_collision - after_physics what the collision response did, after_collision - after_plasticity the
-// elastic energy the flow rules released (at least the reported plastic work: weakening releases some too).
+// elastic energy the flow rules released (at least the reported plastic work: weakening releases some too),
+// after_fracture - after_plasticity and after_remeshing - after_fracture what the topology edits and their moves
+// added (ideally nothing: an opening conserves mass and momentum and should release, not add, elastic energy).
 struct StepEnergies {
-  double start = 0, after_physics = 0, after_collision = 0, after_plasticity = 0;
+  double start = 0, after_physics = 0, after_collision = 0, after_plasticity = 0, after_fracture = 0,
+         after_remeshing = 0;  // after_remeshing: equal to after_fracture in steps that do not remesh
 };
 
 // Wall-clock seconds spent per module since the counters were last cleared.
