@@ -124,6 +124,29 @@ Eigen::AlignedBox3d bounds_of(const std::vector<RenderMesh>& meshes) {
   return box;
 }
 
+Eigen::AlignedBox3d bulk_bounds(const std::vector<Vec3>& points, double fraction) {
+  std::array<std::vector<double>, 3> coordinates;
+  for (const Vec3& p : points)
+    if (p.allFinite())
+      for (int a = 0; a < 3; ++a) coordinates[a].push_back(p(a));
+  Eigen::AlignedBox3d box;
+  if (coordinates[0].empty()) return box;
+  const size_t n = coordinates[0].size();
+  const size_t low = std::min(n - 1, static_cast<size_t>(std::clamp(fraction, 0.0, 0.5) * (n - 1)));
+  const size_t high = n - 1 - low;
+  Vec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double>& c = coordinates[a];
+    std::nth_element(c.begin(), c.begin() + low, c.end());
+    lo(a) = c[low];
+    std::nth_element(c.begin(), c.begin() + high, c.end());
+    hi(a) = c[high];
+  }
+  box.extend(lo);
+  box.extend(hi);
+  return box;
+}
+
 void check_render_mesh(const RenderMesh& mesh, const std::string& what) {
   const int n = int(mesh.positions.size());
   for (int i = 0; i < n; ++i)

@@ -37,6 +37,12 @@ RenderMesh render_mesh_from(const Mesh& mesh, bool highlight_boundary = true);
 Eigen::AlignedBox3d bounds_of(const RenderMesh& mesh);
 Eigen::AlignedBox3d bounds_of(const std::vector<RenderMesh>& meshes);
 
+// The box holding most of the points: per axis, from the `fraction`-quantile to the (1 - fraction)-quantile of
+// the finite points' coordinates (all of them for fraction 0; empty box if there are none). For framing a
+// camera on where a sheet is over an animation without the few points that leave the scene (a shard falling
+// away from paper-tearing.json's sheet took the camera 80 m down with it).
+Eigen::AlignedBox3d bulk_bounds(const std::vector<Vec3>& points, double fraction);
+
 // Throws InputError "<what>: ..." naming the first triangle or edge with an index out of range or a vertex with a
 // non-finite position. The renderer calls it; `what` names the mesh (e.g. "cloth 0").
 void check_render_mesh(const RenderMesh& mesh, const std::string& what);

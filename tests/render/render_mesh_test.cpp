@@ -84,5 +84,23 @@ TEST(RenderMesh, CheckRejectsBadIndicesAndPositions) {
   EXPECT_THROW(check_render_mesh(bad_position, "obstacle 2"), InputError);
 }
 
+// A 10 x 10 grid of points in the unit square at z = 0, and one point 80 m below (a shard falling away): the bulk
+// box without the farthest 1% along each axis is the square; with fraction 0 it is the whole box.
+TEST(RenderMesh, BulkBoundsLeaveOutTheFewPointsThatFallAway) {
+  std::vector<Vec3> points;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) points.emplace_back(i / 9.0, j / 9.0, 0);
+  points.emplace_back(0.5, 0.5, -80);
+  points.emplace_back(kInfinity, 0, 0);  // non-finite points are ignored
+  const Eigen::AlignedBox3d bulk = bulk_bounds(points, 0.01);
+  EXPECT_TRUE(bulk.min().isApprox(Vec3(0, 0, 0))) << bulk.min().transpose();
+  EXPECT_TRUE(bulk.max().isApprox(Vec3(1, 1, 0))) << bulk.max().transpose();
+  const Eigen::AlignedBox3d all = bulk_bounds(points, 0);
+  EXPECT_DOUBLE_EQ(all.min().z(), -80);
+  EXPECT_DOUBLE_EQ(all.max().x(), 1);
+  EXPECT_TRUE(bulk_bounds({}, 0.01).isEmpty());
+  EXPECT_TRUE(bulk_bounds({Vec3(kInfinity, 0, 0)}, 0.01).isEmpty());
+}
+
 }  // namespace
 }  // namespace arcsim
