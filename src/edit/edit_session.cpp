@@ -456,7 +456,9 @@ bool EditSession::move_node(int node, const Vec3& displacement, const NodeMoveOp
   if (guard_) before = guard_->fan(node);
   std::vector<std::pair<int, Mat32>> deformation;  // the faces' total deformation gradients before the move
   if (options.stress_free)
-    for (int f : m_.node_faces(node)) deformation.emplace_back(f, face_deformation_gradient(m_, f));
+    for (int f : m_.node_faces(node))
+      if (!is_plastic_material(materials_[m_.faces[f].material]))
+        deformation.emplace_back(f, face_deformation_gradient(m_, f));
   n.x += displacement;
   n.x0 += displacement;
   if (!keep_move(node, before, x, x0, options)) return false;

@@ -116,6 +116,9 @@ struct NodeMoveOptions {
   // apart by a gap the collision stage needs (twice the projection thickness, 2e-5 m in ARCSim's scenes), and
   // over glass's 1 mm faces that gap is a 1% strain, 25 times glass's critical strain: every opening of
   // sphere-break.json added elastic energy (72 J in one step) and its stress cracked the lips' neighbours.
+  // Faces of plastic materials keep their Fp: the flow rules and the plastic embedding own it there (a rebuild
+  // from the embedding rescales the thickness with det Fp, which changed the mass), and a ductile sheet yields
+  // to a strain of that size anyway.
   bool stress_free = false;
 };
 

@@ -501,12 +501,8 @@ void rebuild_plasticity_from_embedding(Mesh& m, const std::vector<Material>& mat
     const Mat2 old_Fp2 = face_plastic_stretch_2d(face);
     const Mat2 Fp2 = plastic_stretch_from_embedding(m, emb, f, old_Fp2, materials[face.material].plastic_limit);
     // Volume kept as the stretching flow rule keeps it (plasticity/stretch_flow.hpp): h scales with det(Fp2).
-    // Only where that rule runs: a bending-only material never thins, and there Fp2 is a discrete metric (see
-    // above) or a crack lip's stress-free gap (EditSession's NodeMoveOptions::stress_free), whose rebuild
-    // rescaled h, and with it the mass, by the embedding's round-off (1e-7 of a sheet's mass per opening).
     const double old_det = old_Fp2.determinant();
-    if (old_det > 0 && has_stretch_plasticity(materials[face.material]))
-      face.thickness *= Fp2.determinant() / old_det;
+    if (old_det > 0) face.thickness *= Fp2.determinant() / old_det;
     face.Fp = face_plastic_stretch_3d(face, Fp2);
   }
 }

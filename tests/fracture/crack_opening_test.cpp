@@ -541,9 +541,9 @@ class RandomRun {
 };
 
 // On an elastic sheet and on a plastic one (bending plasticity) alike, openings and edits conserve mass and
-// momentum to round-off. On the plastic sheet an edit next to earlier lips rebuilds the faces' plastic stretch
-// from the plastic embedding (the lips carry one: they are set apart stress-free, EditSession's
-// NodeMoveOptions::stress_free); that rebuild used to rescale the thickness, and with it the mass, by 1e-7.
+// momentum to round-off. (The lips of an elastic sheet are set apart stress-free, EditSession's
+// NodeMoveOptions::stress_free, and carry a plastic stretch; a plastic sheet's lips keep Fp = I: there a rebuild
+// from the plastic embedding would rescale the thickness with det Fp and move 1e-7 of the mass per opening.)
 Material elastic_sheet() {
   Material m = testing::aluminium_sheet(1.0);
   m.yield_curv = kInfinity;
