@@ -444,6 +444,8 @@ TEST(FractureBending, GlassStripCracksAtTheCriticalSurfaceStrain) {
 // breaks in two at onset (13 pieces with the single linearised step), but held, each half relaxes straight along
 // its clamp's tangent and the two halves jam lip against lip in the sheet's plane: the collision stage meets
 // ill-conditioned impact zones from the next step on and the run does not finish within 10 minutes.
+// Measured again 2026-12-02 afternoon, with split far ends set apart and stress-free lips: the run finishes in
+// 0.7 s and breaks in 2 at onset, but 16 more cracks open while it is held.
 TEST(FractureBending, DISABLED_HeldAtTheOnsetCurvatureTheBrokenStripStopsCracking) {
   const double kappa_crit = critical_curvature(0.8);
   const BendingRun r = bend_until_crack(0.8, kappa_crit / 100, 2 * kappa_crit, 20);
