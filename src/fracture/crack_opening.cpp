@@ -303,8 +303,7 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
   out.ok = true;
   if (options.lip_gap > 0) {
     // A far end the crack reached on a border is split too, and its halves start just as coincident.
-    std::vector<int> split = out.nodes;
-    for (const std::array<int, 2>& twins : out.far_ends) split.insert(split.end(), twins.begin(), twins.end());
+    const std::vector<int> split = out.split_nodes();
     for (int n : out.nodes) set_lip_apart(session, n, 0.5 * options.lip_gap, out.nodes, split);
     for (const std::array<int, 2>& twins : out.far_ends) {
       const std::vector<int> pair(twins.begin(), twins.end());

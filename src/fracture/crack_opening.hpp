@@ -73,6 +73,13 @@ struct CrackOpening {
   // Far ends already on a border that split_node split with the node: {far end, its copy}. Their halves are
   // set lip_gap apart like the node's (coincident halves have no contact normal: paper-tearing.json, step 966).
   std::vector<std::array<int, 2>> far_ends;
+  // Every node the opening split: `nodes`, then both halves of each far end. They all start coincident with a
+  // twin, so their lips are set apart and their neighbourhoods count as touched by the opening.
+  std::vector<int> split_nodes() const {
+    std::vector<int> out = nodes;
+    for (const std::array<int, 2>& twins : far_ends) out.insert(out.end(), twins.begin(), twins.end());
+    return out;
+  }
   int edge_splits = 0, snaps = 0;
   bool mesh_changed = false;     // an edit succeeded (true when ok; see above for when it is true and !ok)
 };

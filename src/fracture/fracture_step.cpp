@@ -325,19 +325,16 @@ void open_without_substepping(Mesh& mesh, const std::vector<Material>& materials
     const CrackOpening opening = open_at(mesh, materials, c, params, context, pass, stats);
     if (!opening.ok) continue;
     for (int m : fan_nodes) mark(touched, m);
-    for (int m : opening.nodes) mark(touched, m);
-    for (const auto& twins : opening.far_ends)
-      for (int m : twins) mark(touched, m);
+    for (int m : opening.split_nodes()) mark(touched, m);
   }
 }
 
-// The nodes within `rings` rings of the opening (its node, the node's copies, split far ends and the new tips; for a refused
-// opening, the node), on the mesh as it is after it, merged into the sorted `region`.
+// The nodes within `rings` rings of the opening (every node it split and the new tips; for a refused opening,
+// the node), on the mesh as it is after it, merged into the sorted `region`.
 void add_opening_region(const Mesh& mesh, int node, const CrackOpening& opening, int rings,
                         std::vector<int>& region) {
-  std::vector<int> seeds = opening.nodes;
+  std::vector<int> seeds = opening.split_nodes();
   seeds.push_back(node);
-  for (const auto& twins : opening.far_ends) seeds.insert(seeds.end(), twins.begin(), twins.end());
   seeds.insert(seeds.end(), opening.tips.begin(), opening.tips.end());
   seeds.erase(std::remove_if(seeds.begin(), seeds.end(),
                              [&](int n) { return n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead; }),
