@@ -69,6 +69,11 @@ void OutputFolder::write_static_obstacles(const Simulation& sim) {
 
 void OutputFolder::write_frame(const Simulation& sim) {
   const int frame = sim.frame();
+  // Nothing non-finite ever reaches the disk: a frame is written whole from a finite state, or not at all.
+  const std::string problem = sim.nonfinite_state();
+  if (!problem.empty())
+    throw NumericalError("frame " + std::to_string(frame) + " not written: " + problem + " (step " +
+                         std::to_string(sim.step()) + ")");
   for (size_t c = 0; c < sim.cloths.size(); ++c)
     write_obj(sim.cloths[c].mesh, path(cloth_frame_file_name(frame, static_cast<int>(c))));
   for (size_t i = 0; i < sim.obstacles.size(); ++i)

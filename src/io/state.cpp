@@ -650,7 +650,11 @@ void write_file_atomically(const std::string& path, const std::string& bytes) {
 
 }  // namespace
 
-void save_state(const Simulation& sim, const std::string& path) { write_file_atomically(path, encode_state(sim)); }
+void save_state(const Simulation& sim, const std::string& path) {
+  const std::string problem = sim.nonfinite_state();
+  if (!problem.empty()) throw NumericalError(path + ": not written: " + problem);
+  write_file_atomically(path, encode_state(sim));
+}
 
 void load_state(Simulation& sim, const std::string& path) {
   const std::string bytes = read_file(path);

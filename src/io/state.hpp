@@ -33,8 +33,9 @@ class Simulation;
 constexpr uint32_t kStateFormatVersion = 1;
 
 // Writes the state to `path` atomically (a temporary file renamed over it). Throws InputError "<path>: cannot
-// write (...)" if the file cannot be written, std::logic_error if a cloth mesh holds removed elements (the
-// simulation compacts after every topology phase, so a state is only saved between steps).
+// write (...)" if the file cannot be written, NumericalError "<path>: not written: ..." (nothing written) if the
+// state holds a non-finite number (Simulation::nonfinite_state), std::logic_error if a cloth mesh holds removed
+// elements (the simulation compacts after every topology phase, so a state is only saved between steps).
 void save_state(const Simulation& sim, const std::string& path);
 
 // Overwrites the evolving state of `sim` (constructed from the same scene) with the file's and marks every

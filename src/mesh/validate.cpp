@@ -443,38 +443,45 @@ class MeshChecker {
   }
 
   bool check_finite_state() {
-    for (size_t i = 0; i < m_.nodes.size(); ++i) {
-      const Node& n = m_.nodes[i];
-      if (n.dead) continue;
-      if (!n.x.allFinite() || !n.x0.allFinite() || !n.v.allFinite() || !n.a.allFinite() || !std::isfinite(n.mass))
-        return fail("node", static_cast<int>(i), "has non-finite x, x0, v, a or mass");
-    }
-    for (size_t i = 0; i < m_.verts.size(); ++i) {
-      const Vert& v = m_.verts[i];
-      if (!v.dead && (!v.u.allFinite() || !v.sizing.allFinite()))
-        return fail("vert", static_cast<int>(i), "has non-finite u or sizing");
-    }
-    for (size_t i = 0; i < m_.edges.size(); ++i) {
-      const Edge& e = m_.edges[i];
-      if (!e.dead && (!std::isfinite(e.rest_theta) || !std::isfinite(e.damage)))
-        return fail("edge", static_cast<int>(i), "has non-finite rest_theta or damage");
-    }
-    for (size_t i = 0; i < m_.faces.size(); ++i) {
-      const Face& f = m_.faces[i];
-      if (f.dead) continue;
-      if (!std::isfinite(f.thickness) || !f.Fp.allFinite() || !f.Sp.allFinite() || !std::isfinite(f.damage))
-        return fail("face", static_cast<int>(i), "has non-finite thickness, Fp, Sp or damage");
-      if (!std::isfinite(f.rest_area) || !f.rest_normal.allFinite() || !f.rest_frame.allFinite() ||
-          !f.Dm_inv.allFinite())
-        return fail("face", static_cast<int>(i), "has non-finite derived rest data");
-    }
-    return true;
+    problem_ = nonfinite_state(m_);
+    return problem_.empty();
   }
 };
 
 }  // namespace
 
 void validate_triangles(const TriangleInput& in, const std::string& file) { InputChecker(in, file).run(); }
+
+std::string nonfinite_state(const Mesh& mesh) {
+  auto problem = [](const char* what, size_t index, const char* text) {
+    return std::string(what) + " " + std::to_string(index) + ": " + text;
+  };
+  for (size_t i = 0; i < mesh.nodes.size(); ++i) {
+    const Node& n = mesh.nodes[i];
+    if (n.dead) continue;
+    if (!n.x.allFinite() || !n.x0.allFinite() || !n.v.allFinite() || !n.a.allFinite() || !std::isfinite(n.mass))
+      return problem("node", i, "has non-finite x, x0, v, a or mass");
+  }
+  for (size_t i = 0; i < mesh.verts.size(); ++i) {
+    const Vert& v = mesh.verts[i];
+    if (!v.dead && (!v.u.allFinite() || !v.sizing.allFinite())) return problem("vert", i, "has non-finite u or sizing");
+  }
+  for (size_t i = 0; i < mesh.edges.size(); ++i) {
+    const Edge& e = mesh.edges[i];
+    if (!e.dead && (!std::isfinite(e.rest_theta) || !std::isfinite(e.damage)))
+      return problem("edge", i, "has non-finite rest_theta or damage");
+  }
+  for (size_t i = 0; i < mesh.faces.size(); ++i) {
+    const Face& f = mesh.faces[i];
+    if (f.dead) continue;
+    if (!std::isfinite(f.thickness) || !f.Fp.allFinite() || !f.Sp.allFinite() || !std::isfinite(f.damage))
+      return problem("face", i, "has non-finite thickness, Fp, Sp or damage");
+    if (!std::isfinite(f.rest_area) || !f.rest_normal.allFinite() || !f.rest_frame.allFinite() ||
+        !f.Dm_inv.allFinite())
+      return problem("face", i, "has non-finite derived rest data");
+  }
+  return "";
+}
 
 std::string check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
   return MeshChecker(mesh, options).run();

@@ -40,6 +40,11 @@ struct MeshCheckOptions {
 };
 std::string check_mesh(const Mesh& mesh, const MeshCheckOptions& options = {});
 
+// Returns "" if every stored number of the live elements is finite (node x, x0, v, a, mass; vert u, sizing; edge
+// rest angle, damage; face thickness, Fp, Sp, damage, derived rest data), else "<element> <index>: <problem>"
+// (0-based index). check_mesh's require_finite_state, on its own: cheap enough to guard every file write.
+std::string nonfinite_state(const Mesh& mesh);
+
 // A rest triangle counts as degenerate (zero area) when twice its area is at most this fraction of its longest
 // edge squared (about the sine of its smallest angle): the scale-free test shared by validate_triangles,
 // check_mesh and the topology edits, so that no edit creates a face the checks reject.

@@ -8,6 +8,7 @@
 #include "fracture/fracture_sizing.hpp"
 #include "io/obj.hpp"
 #include "math/errors.hpp"
+#include "mesh/validate.hpp"
 #include "plasticity/plastic_step.hpp"
 #include "sim/remesh_cloth.hpp"
 
@@ -259,6 +260,25 @@ void Simulation::collision_step(double dt) {
   for (Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
   collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
   step_fallback_nodes_ = collisions_.fallback_nodes();
+}
+
+std::string Simulation::nonfinite_state() const {
+  if (!std::isfinite(time_)) return "the simulation time is not finite";
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    const std::string problem = arcsim::nonfinite_state(cloths[c].mesh);
+    if (!problem.empty()) return "cloth " + std::to_string(c) + " " + problem;
+  }
+  for (size_t i = 0; i < obstacles.size(); ++i)
+    for (size_t n = 0; n < obstacles[i].mesh.nodes.size(); ++n) {
+      const Node& node = obstacles[i].mesh.nodes[n];
+      if (!node.x.allFinite() || !node.x0.allFinite() || !node.v.allFinite())
+        return "obstacle " + std::to_string(i) + " node " + std::to_string(n) + ": has non-finite x, x0 or v";
+    }
+  for (size_t h = 0; h < handles.size(); ++h)
+    for (size_t k = 0; k < handles[h].anchors.size(); ++k)
+      if (!handles[h].anchors[k].allFinite())
+        return "handle " + std::to_string(h) + " anchor " + std::to_string(k) + ": is not finite";
+  return "";
 }
 
 void Simulation::check_state() const {

@@ -85,6 +85,10 @@ class Simulation {
   // Steps until the next frame boundary.
   void advance_frame();
   bool finished() const;
+  // "" if every number of the evolving state is finite (time, each cloth's mesh state, obstacle positions and
+  // velocities, handle anchors), else "<where>: <problem>" naming the first element that is not. The output
+  // guard: no frame or state file is written from a state that fails it.
+  std::string nonfinite_state() const;
 
   const Scene& scene() const { return scene_; }
   double time() const { return time_; }
