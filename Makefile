@@ -27,7 +27,7 @@ BENCH_SRC := $(shell find tools/bench -name '*.cpp' 2>/dev/null | sort)
 
 obj = $(patsubst %.cpp,build/$(1)/%.o,$(2))
 
-.PHONY: all deps check check-release check-asan demo bench clean slowcheck
+.PHONY: all deps check check-release check-asan demo bench clean slowcheck fuzz
 
 all: bin/arcsim
 
@@ -102,6 +102,48 @@ check-asan: bin/arcsim-asan bin/arcsim-tests-asan
 	$(TEST_ENV) ARCSIM_BIN=$(CURDIR)/bin/arcsim-asan ARCSIM_SANITIZED=1 OMP_NUM_THREADS=2 \
 	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ./bin/arcsim-tests-asan --gtest_brief=1 --gtest_filter='-*Slow*'
+
+# libFuzzer targets (fuzz/): the OBJ reader, the scene parser and the state-file reader, built with clang under
+# AddressSanitizer + UndefinedBehaviorSanitizer. `make fuzz` runs each for FUZZ_SECONDS (CI: 60 s; the long runs
+# reported in docs/stability.md: FUZZ_SECONDS=3600) from a seed corpus of conf/, meshes/, fuzz/state_scene/ and,
+# where present, ARCSim's scenes and meshes. A finding stops make with the input saved under build/fuzz/findings/.
+FUZZ_CXX      ?= clang++
+FUZZ_SECONDS  ?= 60
+FUZZ_FLAGS    := -std=c++17 -O1 -g -fno-omit-frame-pointer -fopenmp -Isrc $(CHOLMOD_CFLAGS) \
+                 $(patsubst -I%,-isystem %,$(shell pkg-config --cflags $(PKGS) 2>/dev/null)) \
+                 -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
+FUZZ_TARGETS  := obj_reader scene_parser state_reader
+ARCSIM_SCENES := $(abspath $(CURDIR)/../shared/arcsim-0.3-scenes)
+
+build/fuzz/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(FUZZ_CXX) $(FUZZ_FLAGS) -MMD -MP -c $< -o $@
+
+bin/fuzz-%: build/fuzz/fuzz/%_fuzzer.o $(call obj,fuzz,$(LIB_SRC))
+	@mkdir -p bin
+	$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined -fopenmp -o $@ $^ $(filter-out -fopenmp,$(LIBS))
+
+# Seeds: small files only (libFuzzer mutates up to the largest seed's length).
+build/fuzz/seeds.stamp: bin/arcsim $(wildcard conf/*.json meshes/*.obj fuzz/state_scene/*)
+	rm -rf build/fuzz/seeds && mkdir -p build/fuzz/seeds/obj_reader build/fuzz/seeds/scene_parser build/fuzz/seeds/state_reader
+	find meshes fuzz/state_scene $(wildcard $(ARCSIM_SCENES)/meshes) -name '*.obj' -size -64k -exec cp {} build/fuzz/seeds/obj_reader/ \;
+	find conf $(wildcard $(ARCSIM_SCENES)/conf $(ARCSIM_SCENES)/materials) fuzz/state_scene -name '*.json' -size -64k \
+	  -exec sh -c 'cp "$$1" "build/fuzz/seeds/scene_parser/$$(echo "$$1" | tr / _)"' _ {} \;
+	rm -rf build/fuzz/state_run && ./bin/arcsim simulate fuzz/state_scene/scene.json build/fuzz/state_run > /dev/null 2>&1
+	cp build/fuzz/state_run/*.state build/fuzz/seeds/state_reader/
+	touch $@
+
+fuzz: deps
+	@$(MAKE) --no-print-directory $(addprefix bin/fuzz-,$(FUZZ_TARGETS)) build/fuzz/seeds.stamp
+	@for t in $(FUZZ_TARGETS); do \
+	  mkdir -p build/fuzz/corpus/$$t build/fuzz/findings/$$t; \
+	  echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
+	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ./bin/fuzz-$$t build/fuzz/corpus/$$t \
+	    build/fuzz/seeds/$$t -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
+	    -artifact_prefix=build/fuzz/findings/$$t/ 2> build/fuzz/$$t.log \
+	    || { tail -n 60 build/fuzz/$$t.log; echo "fuzz: $$t found a failing input (build/fuzz/findings/$$t/)"; exit 1; }; \
+	  grep -E '^stat::(number_of_executed_units|new_units_added|peak_rss_mb)' build/fuzz/$$t.log | tr '\n' ' '; echo; \
+	done
 
 demo: deps
 	@$(MAKE) --no-print-directory bin/arcsim

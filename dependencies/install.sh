@@ -15,7 +15,8 @@ PACKAGES=(
   libosmesa6-dev           # off-screen OpenGL rendering
   libgtest-dev             # tests
   libbenchmark-dev         # benchmarks
-  libomp-dev               # OpenMP runtime headers (g++ ships libgomp)
+  libomp-dev               # OpenMP runtime (clang's libomp for the fuzz build; g++ ships libgomp)
+  clang libclang-rt-14-dev # libFuzzer and the sanitizers for `make fuzz` (fuzz/)
 )
 
 missing=()
