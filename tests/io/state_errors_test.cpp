@@ -6,8 +6,10 @@
 #include <stdlib.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -345,16 +347,52 @@ TEST_F(StateErrors, BadReferencesAndValuesInsideAWellFormedFile) {
     EXPECT_EQ(load_error(sim, bad), bad + ": " + c.message);
     expect_untouched(sim, scene_);
   }
-  // Non-finite state and broken adjacency are found by the mesh checks (message from mesh/validate.hpp).
-  for (auto corrupt : {+[](Simulation& s) { s.cloths[0].mesh.nodes[3].v.y() = std::nan(""); },
-                       +[](Simulation& s) { s.cloths[0].mesh.verts[0].faces.clear(); }}) {
+  // Broken adjacency is found by the mesh checks (message from mesh/validate.hpp).
+  {
     Simulation source(scene_);
-    corrupt(source);
+    source.cloths[0].mesh.verts[0].faces.clear();
     save_state(source, path("bad.state"));
     Simulation sim(scene_);
     EXPECT_TRUE(starts_with(load_error(sim, path("bad.state")), path("bad.state") + ": cloth 0: "));
     expect_untouched(sim, scene_);
   }
+  // So is a non-finite number. save_state refuses to write one, so the file is saved with a marker value in its
+  // place, the marker's 8 bytes are overwritten with a NaN's and the checksum is made valid again.
+  {
+    Simulation source(scene_);
+    constexpr double kMarker = 1234.5678125;  // exact in binary; nowhere else in the state
+    source.cloths[0].mesh.nodes[3].v.y() = kMarker;
+    save_state(source, path("nan.state"));
+    std::string bytes = read_bytes(path("nan.state"));
+    std::string marker(8, '\0'), nan(8, '\0');
+    const double nan_value = std::nan("");
+    std::memcpy(marker.data(), &kMarker, 8);
+    std::memcpy(nan.data(), &nan_value, 8);
+    const size_t at = bytes.find(marker);
+    ASSERT_NE(at, std::string::npos);
+    ASSERT_EQ(bytes.find(marker, at + 1), std::string::npos);
+    bytes.replace(at, 8, nan);
+    bytes.resize(bytes.size() - 8);
+    put_le(bytes, fnv1a64(bytes.data(), bytes.size()), 8);
+    write_bytes(path("nan.state"), bytes);
+    Simulation sim(scene_);
+    const std::string error = load_error(sim, path("nan.state"));
+    EXPECT_TRUE(starts_with(error, path("nan.state") + ": cloth 0: node 3")) << error;
+    expect_untouched(sim, scene_);
+  }
+}
+
+TEST_F(StateErrors, ANonFiniteStateIsNeverWritten) {
+  Simulation source(scene_);
+  source.cloths[0].mesh.faces[1].Fp(0, 0) = std::numeric_limits<double>::infinity();
+  try {
+    save_state(source, path("inf.state"));
+    FAIL() << "a state with an infinite Fp was written";
+  } catch (const NumericalError& e) {
+    EXPECT_EQ(std::string(e.what()), path("inf.state") + ": not written: cloth 0 face 1: has non-finite thickness, "
+                                                         "Fp, Sp or damage");
+  }
+  EXPECT_FALSE(fs::exists(path("inf.state")));
 }
 
 TEST_F(StateErrors, UnwritablePathIsAnInputError) {
