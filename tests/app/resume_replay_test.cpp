@@ -45,6 +45,17 @@ std::string resume_scene(const TempFolder& dir) {
   })");
 }
 
+// Starts `arcsim simulate <scene> <out> <options>` in the background (output discarded) and returns its pid.
+int start_simulate_in_background(const std::string& scene, const std::string& out, const std::string& options) {
+  const std::string command = shell_quote(binary()) + " simulate " + shell_quote(scene) + " " + shell_quote(out) +
+                              " " + options + " >/dev/null 2>&1 & echo $!";
+  FILE* pipe = popen(command.c_str(), "r");
+  int pid = 0;
+  if (pipe == nullptr || fscanf(pipe, "%d", &pid) != 1) pid = 0;
+  if (pipe != nullptr) pclose(pipe);
+  return pid;
+}
+
 void expect_same_file(const std::string& a, const std::string& b) {
   ASSERT_TRUE(fs::exists(a)) << a;
   ASSERT_TRUE(fs::exists(b)) << b;
@@ -74,13 +85,8 @@ TEST(Resume, AfterKillNineResumesFromTheLastCompleteFrame) {
 
   // Start a long run in the background and kill it hard once some frames exist.
   const std::string out = dir / "killed";
-  const std::string command = shell_quote(binary()) + " simulate " + shell_quote(scene) + " " + shell_quote(out) +
-                              " --quiet --end-frame 100000 >/dev/null 2>&1 & echo $!";
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  int pid = 0;
-  ASSERT_EQ(fscanf(pipe, "%d", &pid), 1);
-  pclose(pipe);
+  const int pid = start_simulate_in_background(scene, out, "--quiet --end-frame 100000");
+  ASSERT_GT(pid, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (!fs::exists(out + "/00012.state") && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -210,13 +216,8 @@ TEST(Resume, SlowCheckKilledAtRandomMomentsOfATearingRunResumesByteIdentically) 
   for (int trial = 0; trial < 20; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial));
     const std::string out = dir / ("killed" + std::to_string(trial));
-    const std::string command = shell_quote(binary()) + " simulate " + shell_quote(scene) + " " + shell_quote(out) +
-                                " --quiet --threads 1 >/dev/null 2>&1 & echo $!";
-    FILE* pipe = popen(command.c_str(), "r");
-    ASSERT_NE(pipe, nullptr);
-    int pid = 0;
-    ASSERT_EQ(fscanf(pipe, "%d", &pid), 1);
-    pclose(pipe);
+    const int pid = start_simulate_in_background(scene, out, "--quiet --threads 1");
+    ASSERT_GT(pid, 0);
     // From the first complete frame on (before it there is nothing to resume from), a random moment.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (!fs::exists(out + "/00000.state") && std::chrono::steady_clock::now() < deadline)

@@ -14,6 +14,7 @@
 #include "collision/penetration.hpp"
 #include "collision/scene_fixtures.hpp"
 #include "io/scene_parser.hpp"
+#include "stress/repository.hpp"
 #include "sim/simulation.hpp"
 
 namespace arcsim {
@@ -22,22 +23,13 @@ namespace {
 namespace fs = std::filesystem;
 using namespace testing;
 
-fs::path repository_root() {
-  std::error_code no_throw;
-  const fs::path binary = fs::read_symlink("/proc/self/exe", no_throw);
-  for (const fs::path& candidate : {fs::path("."), binary.parent_path().parent_path(),
-                                    fs::path(__FILE__).parent_path() / "../.."})
-    if (fs::exists(candidate / "conf/fast-sphere.json", no_throw)) return fs::absolute(candidate);
-  return {};
-}
-
 void replace_all(std::string& text, const std::string& from, const std::string& to) {
   for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
     text.replace(at, from.size(), to);
 }
 
 TEST(StressFastImpact, SphereAt50MetresPerSecondDoesNotTunnelThroughAThinSheet) {
-  const fs::path root = repository_root();
+  const fs::path root = repository_root("conf/fast-sphere.json");
   ASSERT_FALSE(root.empty()) << "conf/fast-sphere.json not found";
   std::ifstream in(root / "conf/fast-sphere.json");
   std::stringstream text;

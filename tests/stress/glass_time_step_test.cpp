@@ -14,6 +14,7 @@
 
 #include "collision/scene_fixtures.hpp"
 #include "io/scene_parser.hpp"
+#include "stress/repository.hpp"
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
 
@@ -22,15 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace testing;
-
-fs::path repository_root() {
-  std::error_code no_throw;
-  const fs::path binary = fs::read_symlink("/proc/self/exe", no_throw);
-  for (const fs::path& candidate : {fs::path("."), binary.parent_path().parent_path(),
-                                    fs::path(__FILE__).parent_path() / "../.."})
-    if (fs::exists(candidate / "meshes/square.obj", no_throw)) return fs::absolute(candidate);
-  return {};
-}
 
 std::string glass_plate_scene(const fs::path& root, const std::string& step) {
   const std::string square = (root / "meshes/square.obj").string(), ground = (root / "meshes/ground.obj").string();
@@ -51,7 +43,7 @@ std::string glass_plate_scene(const fs::path& root, const std::string& step) {
 }
 
 TEST(StressGlassSlow, PlateThrownAtAFloorHoldsAtTwoFiveAndTenTimesArcsimsStep) {
-  const fs::path root = repository_root();
+  const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
   const fs::path folder = fs::temp_directory_path() / ("arcsim-glass-" + std::to_string(::getpid()));
   fs::create_directories(folder);
