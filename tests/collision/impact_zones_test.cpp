@@ -3,6 +3,8 @@
 // correction, and an infeasible zone falls back to rigid motion / staying put with a warning.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "collision/candidates.hpp"
 #include "collision/collision_step.hpp"
 #include "collision/impact_zones.hpp"
@@ -215,6 +217,47 @@ TEST(ImpactZones, FloorPlaneStopsNodes) {
   BvhCache cache;
   EXPECT_TRUE(resolve_impacts(g, cache, p).resolved);
   for (const Vec3& x : g.x1) EXPECT_NEAR(x.y(), kH, 0.05 * kH);
+}
+
+// A sheet node pressed just under a sphere's lowest vertex (positions recorded from
+// conf/metal-crumple-remesh.json with rounding perturbation seed 2, step 278): a sheet edge from that node and
+// a sphere edge from that vertex meet end to end. The plane of the two edges says nothing about which side
+// the node is on; as the impact's normal, (-0.51, 0.67, -0.54), it asked the node to move mostly sideways
+// while the vertex-face pairs of the same two vertices held it straight below, and the impact zone was
+// ill-conditioned (the sheet was then held at its start while the sphere ran through it). An end-to-end
+// contact takes the direction between the two ends at the start of the step.
+TEST(ImpactZones, EdgesMeetingEndToEndTakeTheDirectionBetweenTheirEnds) {
+  const Vec3 node0(-1.076542559456617e-05, -1.5503998946040989e-05, -0.019100832935156721);
+  const Vec3 node1(-2.258441024918118e-05, -1.6748294503163284e-05, -0.019043520026843935);
+  const Vec3 far0(0.0054241486174765579, 0.0050465164132646508, -0.018029043210994626);
+  const Vec3 far1(0.0054078661047044256, 0.0050374154631604769, -0.017942246724901929);
+  const Vec3 apex0(0, 0, -0.018997082592592619), apex1(0, 0, -0.019132320000000026);
+  const Vec3 up0(-0.013143277803000002, -0.0081229924058000003, -0.01654990840734262);
+  const Vec3 up1(-0.013143277803000002, -0.0081229924058000003, -0.016685145814750026);
+  // Each edge gets one face: the sheet's third node continues the sheet sideways, the sphere's goes up its
+  // other side.
+  const Vec3 side(0.005, -0.005, 0), mirror(0.026286555606, 0, 0);
+  Mesh sheet = Mesh::from_triangles({node1, far1, far1 + side}, {node1, far1, far1 + side}, {0, 1, 2},
+                                    {{0, 1, 2}});
+  sheet.nodes[0].x0 = node0, sheet.nodes[1].x0 = far0, sheet.nodes[2].x0 = far0 + side;
+  for (Node& n : sheet.nodes) n.mass = 1e-4;
+  Mesh sphere = Mesh::from_triangles({apex1, up1, up1 + mirror}, {apex1, up1, up1 + mirror}, {0, 1, 2},
+                                     {{0, 2, 1}});
+  sphere.nodes[0].x0 = apex0, sphere.nodes[1].x0 = up0, sphere.nodes[2].x0 = up0 + mirror;
+  ContactGeometry g;
+  build_contact_geometry({{&sheet, true}, {&sphere, false}}, ContactStage::kAfterStep, 1e-3, g);
+  const int apex = g.meshes[1].node_begin, up = apex + 1;
+  BvhCache cache;
+  int checked = 0;
+  for (const ImpactRecord& r : detect_impacts(g, cache, params())) {
+    if (r.kind != static_cast<int>(PairKind::kEdgeEdge)) continue;
+    const std::array<int, 4> edges{0, 1, apex, up};
+    if (!std::is_permutation(r.nodes.begin(), r.nodes.end(), edges.begin())) continue;
+    ++checked;
+    const Vec3 start = r.nodes[0] == 0 || r.nodes[1] == 0 ? Vec3(node0 - apex0) : Vec3(apex0 - node0);
+    EXPECT_GT(r.normal.dot(start.normalized()), 1 - 1e-12) << "normal " << r.normal.transpose();
+  }
+  EXPECT_EQ(checked, 1) << "the two edges' impact was not found";
 }
 
 TEST(ImpactZones, InfeasibleZoneFallsBackWithWarning) {
