@@ -4,7 +4,7 @@ seconds, samples the process's resident set size (VmRSS) from /proc every --inte
 after warm-up (the first sample past --warmup of the run's wall time), the largest RSS after that and the growth
 between them, in percent. Exit status 1 if the growth exceeds --limit percent.
 
-  tools/rss_growth.py conf/demo.json --end-time 100      # 10 000 steps of the demo scene
+  tools/rss_growth.py conf/swing.json --end-time 100      # 10 000 steps of the swinging sheet
 """
 import argparse
 import os

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace arcsim {
 
 RemeshOptions remesh_options(const Scene& scene) {
@@ -50,6 +49,29 @@ void remap_handles(std::vector<Handle>& handles, int cloth, const Mesh::Compacti
     }
     h.nodes = std::move(nodes);
     h.anchors = std::move(anchors);
+  }
+}
+
+void HandleLineKeeper::stage_done(EditKind kind, EditStage stage, const EditResult& result) {
+  // At kTopology the new node sits on the chord of the split edge, before any later stage moves it; marking it
+  // preserved there also keeps the reprojection stage from moving it.
+  if (kind != EditKind::kSplitEdge || stage != EditStage::kTopology || !result.ok) return;
+  if (result.added_nodes.size() != 1 || result.removed_edges.empty()) return;
+  const int added = result.added_nodes[0];
+  const std::array<int, 2> ends = mesh_.edges[result.removed_edges[0]].n;
+  for (Handle& h : handles_) {
+    if (h.cloth != cloth_ || h.nodes.size() != h.anchors.size()) continue;
+    const auto a = std::find(h.nodes.begin(), h.nodes.end(), ends[0]);
+    const auto b = std::find(h.nodes.begin(), h.nodes.end(), ends[1]);
+    if (a == h.nodes.end() || b == h.nodes.end()) continue;
+    const Vec3 &xa = mesh_.nodes[ends[0]].x, &xb = mesh_.nodes[ends[1]].x;
+    const double length2 = (xb - xa).squaredNorm();
+    const double t = length2 > 0 ? std::clamp((mesh_.nodes[added].x - xa).dot(xb - xa) / length2, 0.0, 1.0) : 0.5;
+    const Vec3 anchor = (1 - t) * h.anchors[a - h.nodes.begin()] + t * h.anchors[b - h.nodes.begin()];
+    h.nodes.push_back(added);
+    h.anchors.push_back(anchor);
+    mesh_.nodes[added].preserve = true;
+    return;
   }
 }
 

@@ -61,7 +61,10 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   if (scene_.enabled("remeshing") && scene_.magic.fixed_high_res_mesh) {
     const RemeshOptions options = remesh_options(scene_);
     for (size_t c = 0; c < cloths.size(); ++c) {
-      const RemeshStats stats = refine_to_size_min(cloths[c], options);
+      HandleLineKeeper keeper(handles, static_cast<int>(c), cloths[c].mesh);
+      RemeshOptions with_keeper = options;
+      with_keeper.observers.push_back(&keeper);
+      const RemeshStats stats = refine_to_size_min(cloths[c], with_keeper);
       topology_changed(static_cast<int>(c), edited(stats));
     }
   }
@@ -431,7 +434,10 @@ void Simulation::fracture_step(double dt) {
     context.loads = loads_for(static_cast<int>(c), time_);
     if (c < step_contacts_.size()) context.loads.contacts = step_contacts_[c];
     context.untrusted_nodes = c < step_fallback_nodes_.size() ? step_fallback_nodes_[c] : std::vector<int>();
+    HandleLineKeeper keeper(handles, static_cast<int>(c), cloth.mesh);
+    context.remesh.observers = {&keeper};
     const FractureStats s = arcsim::fracture_step(cloth.mesh, cloth.materials, params, context, cloth.zone_solver);
+    context.remesh.observers.clear();
     fracture_stats[c] += s;
     topology_changed(static_cast<int>(c), s.edited);
   }
@@ -453,7 +459,10 @@ void Simulation::remeshing_step() {
       fracture_terms = fracture_sizing_terms(cloths[c].mesh, cloths[c].materials, cloths[c].remeshing.refine_fracture,
                                              cloths[c].remeshing.size_min);
     options.extras.face_terms = fracture_terms.empty() ? nullptr : &fracture_terms;
+    HandleLineKeeper keeper(handles, static_cast<int>(c), cloths[c].mesh);
+    options.observers = {&keeper};
     remesh_stats[c] = remesh(cloths[c], nullptr, options);
+    options.observers.clear();
     options.extras.face_terms = nullptr;
     remesh_stats[c].active_faces.clear();
     topology_changed(static_cast<int>(c), edited(remesh_stats[c]));

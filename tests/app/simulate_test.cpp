@@ -1,4 +1,4 @@
-// `arcsim simulate` end to end: the demo scene's output folder (frames, conf.json and referenced files,
+// `arcsim simulate` end to end: a scene's output folder (frames, conf.json and referenced files,
 // log.jsonl), --progress json, dry runs, option overrides, self-contained output folders and numerical failure.
 #include <gtest/gtest.h>
 #include <json/json.h>
@@ -37,19 +37,20 @@ ObjData read_frame(const std::string& path) {
   return obj;
 }
 
-std::string demo_scene() { return repo_file("conf/demo.json"); }
+// conf/swing.json: a small, fast scene (121 nodes, a vinyl sheet held by two corners) for the mechanics of a run.
+std::string swing_scene() { return repo_file("conf/swing.json"); }
 
-#define ARCSIM_REQUIRE_DEMO()                                                          \
+#define ARCSIM_REQUIRE_SWING()                                                          \
   do {                                                                                 \
     ARCSIM_REQUIRE_BINARY();                                                           \
-    if (demo_scene().empty()) GTEST_SKIP() << "conf/demo.json not found";              \
+    if (swing_scene().empty()) GTEST_SKIP() << "conf/swing.json not found";              \
   } while (0)
 
-TEST(Simulate, DemoSceneWritesFramesSceneCopyAndLog) {
-  ARCSIM_REQUIRE_DEMO();
+TEST(Simulate, SwingSceneWritesFramesSceneCopyAndLog) {
+  ARCSIM_REQUIRE_SWING();
   TempFolder tmp;
-  const std::string out = tmp / "runs/demo";  // parents are created
-  const RunResult r = run_arcsim({"simulate", demo_scene(), out, "--end-frame", "2", "--quiet"});
+  const std::string out = tmp / "runs/swing";  // parents are created
+  const RunResult r = run_arcsim({"simulate", swing_scene(), out, "--end-frame", "2", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_EQ(r.out, "");
@@ -69,10 +70,10 @@ TEST(Simulate, DemoSceneWritesFramesSceneCopyAndLog) {
     EXPECT_LT(lowest, 1.0) << "frame " << f << ": the sheet should have started to fall";
   }
   EXPECT_FALSE(fs::exists(out + "/00003_00.obj"));
-  EXPECT_FALSE(fs::exists(out + "/obs00.obj"));  // the demo has no obstacles
+  EXPECT_FALSE(fs::exists(out + "/obs00.obj"));  // the scene has no obstacles
 
   // The scene and its files, at the paths the scene names them by, so that out/conf.json loads on its own.
-  EXPECT_EQ(read_text(out + "/conf.json"), read_text(demo_scene()));
+  EXPECT_EQ(read_text(out + "/conf.json"), read_text(swing_scene()));
   EXPECT_EQ(read_text(out + "/meshes/square.obj"), read_text(repo_file("meshes/square.obj")));
   EXPECT_EQ(read_text(out + "/materials/vinyl.json"), read_text(repo_file("materials/vinyl.json")));
 
@@ -101,9 +102,9 @@ TEST(Simulate, DemoSceneWritesFramesSceneCopyAndLog) {
 }
 
 TEST(Simulate, ProgressJsonPrintsOneObjectPerFrameAndDryRunWritesNothing) {
-  ARCSIM_REQUIRE_DEMO();
+  ARCSIM_REQUIRE_SWING();
   TempFolder tmp;
-  const RunResult r = run_arcsim({"simulate", "--progress", "json", demo_scene(), "--end-frame=3"}, tmp / "");
+  const RunResult r = run_arcsim({"simulate", "--progress", "json", swing_scene(), "--end-frame=3"}, tmp / "");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");  // JSON mode: no text progress
   const std::vector<Json::Value> lines = parse_json_lines(r.out);

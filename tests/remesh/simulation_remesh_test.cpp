@@ -5,6 +5,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <filesystem>
 
 #include "io/obj.hpp"
@@ -142,6 +145,56 @@ TEST(SimulationRemesh, HandlesSurviveRemeshing) {
   }
   EXPECT_GT(live_faces(sim.cloths[0].mesh), 32);  // the hanging, bending sheet was refined
   ASSERT_EQ(sim.remesh_stats.size(), 1u);
+}
+
+// A sheet clamped along its whole top edge, hanging under gravity and refined below the clamp's spacing: the
+// nodes that splits add between clamped nodes join the clamp (preserved, anchored where they lie on the line),
+// so that the edge stays clamped along its length instead of being held at its original nodes only. Loose
+// nodes between held ones made every held node a point load: a notched sheet pulled apart by two clamped
+// borders tore along them before it tore at its notch (conf/demo.json).
+void expect_top_edge_clamped(const Simulation& sim, double top, int least_nodes, const std::string& when) {
+  SCOPED_TRACE(when);
+  const Mesh& m = sim.cloths[0].mesh;
+  const Handle& clamp = sim.handles[0];
+  ASSERT_EQ(clamp.nodes.size(), clamp.anchors.size());
+  int on_line = 0;
+  for (size_t n = 0; n < m.nodes.size(); ++n) {
+    if (m.nodes[n].dead) continue;
+    const Vec3& u = m.verts[m.nodes[n].verts[0]].u;
+    if (std::abs(u.y() - top) > 1e-12) continue;
+    ++on_line;
+    const auto held = std::find(clamp.nodes.begin(), clamp.nodes.end(), static_cast<int>(n));
+    ASSERT_NE(held, clamp.nodes.end()) << "node " << n << " at x = " << u.x() << " on the clamped edge is loose";
+    EXPECT_TRUE(m.nodes[n].preserve);
+    // Flat and static: a node's anchor is its rest position.
+    EXPECT_LT((clamp.anchors[held - clamp.nodes.begin()] - u).norm(), 1e-12) << "node " << n;
+    EXPECT_LT((m.nodes[n].x - u).norm(), 0.01) << "node " << n;
+  }
+  EXPECT_EQ(on_line, static_cast<int>(clamp.nodes.size()));
+  EXPECT_GE(on_line, least_nodes);
+}
+
+TEST(SimulationRemesh, AClampedEdgeStaysClampedWhereRefinementAddsNodes) {
+  const std::string path = temp_obj(testing::make_grid(4, 4, 0.5, 0.5), "clamped");
+  Scene scene = scene_with(path, cotton());
+  scene.cloths[0].remeshing.size_min = 0.02;
+  scene.cloths[0].remeshing.size_max = 0.06;  // the clamp's 0.125 m spacing is split at least twice
+  scene.gravity = Vec3(0, 0, -9.8);
+  scene.step_time = scene.frame_time = 5e-3;
+  HandleSpec top;
+  top.nodes = {20, 21, 22, 23, 24};  // the top row of the 5 x 5 node grid, y = 0.5
+  scene.handles.push_back(top);
+  Simulation sim(scene);
+  for (int frame = 0; frame < 6; ++frame) {
+    sim.advance_frame();
+    ASSERT_EQ(check_mesh(sim.cloths[0].mesh), "") << frame;
+    expect_top_edge_clamped(sim, 0.5, 17, "frame " + std::to_string(frame));
+  }
+
+  // The same at the one refinement of ARCSim's fixed high-resolution mode.
+  scene.magic.fixed_high_res_mesh = true;
+  Simulation fixed(scene);
+  expect_top_edge_clamped(fixed, 0.5, 17, "fixed_high_res_mesh");
 }
 
 TEST(SimulationRemesh, FixedHighResMeshRefinesOnceAtStart) {
