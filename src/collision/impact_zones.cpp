@@ -134,7 +134,9 @@ std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cac
 
 namespace {
 
-enum class ZoneState { kProjected, kRigid, kFrozen };
+// The fallback ladder of a zone: projected, then moved rigidly with its own mean displacement, then carried
+// with the obstacles it touches (if they moved), then held at its start positions.
+enum class ZoneState { kProjected, kRigid, kCarried, kFrozen };
 
 struct Zone {
   std::vector<int> nodes;  // global, movable
@@ -244,9 +246,27 @@ ZoneResult project_zone(Zone& zone, const std::vector<Vec3>& target, ContactGeom
   return result;
 }
 
-// Rigid fallback: the zone keeps its mean (mass-weighted) displacement of the step, or stays at x0.
+// The displacement over the step of the obstacle points the zone's impacts touch: the weighted mean, over its
+// constraints, of their immovable nodes' displacements (zero if it touches none, or none of them moved).
+Vec3 obstacle_displacement(const Zone& zone, const ContactGeometry& g) {
+  Vec3 sum = Vec3::Zero();
+  double weight = 0;
+  for (const ImpactRecord& r : zone.constraints) {
+    for (int i = 0; i < 4; ++i) {
+      const int n = r.nodes[i];
+      if (n == kNone || r.weights[i] == 0 || g.movable(n)) continue;
+      sum += std::abs(r.weights[i]) * (g.x1[n] - g.x0[n]);
+      weight += std::abs(r.weights[i]);
+    }
+  }
+  return weight > 0 ? Vec3(sum / weight) : Vec3::Zero();
+}
+
+// Rigid fallback: the zone keeps its mean (mass-weighted) displacement of the step, or moves with the obstacles
+// it touches, or stays at x0.
 void move_rigidly(const Zone& zone, const std::vector<Vec3>& target, ContactGeometry& g) {
   Vec3 displacement = Vec3::Zero();
+  if (zone.state == ZoneState::kCarried) displacement = obstacle_displacement(zone, g);
   if (zone.state == ZoneState::kRigid) {
     double mass = 0;
     for (int n : zone.nodes) {
@@ -351,11 +371,21 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
         what << "impact zone of " << z.nodes.size() << " nodes unresolved after " << params.max_iterations
              << " iterations; moving it rigidly";
         warn(params, what.str());
-      } else if (z.state == ZoneState::kRigid && round > 0) {
+      } else if (z.state == ZoneState::kRigid && round > 0 && obstacle_displacement(z, g).norm() > 0) {
+        // WHY: held at its start while an obstacle it touches moves on, the zone is run through: a sheet pressed
+        // by a sphere was left behind inside it and later dragged up (conf/metal-crumple-remesh.json). Carried
+        // along, it keeps its place against that obstacle.
+        z.state = ZoneState::kCarried;
+        std::ostringstream what;
+        what << "rigid impact zone of " << z.nodes.size() << " nodes still collides; moving it with the "
+             << "obstacle it touches";
+        warn(params, what.str());
+      } else if ((z.state == ZoneState::kRigid && round > 0) || z.state == ZoneState::kCarried) {
+        const bool carried = z.state == ZoneState::kCarried;
         z.state = ZoneState::kFrozen;
         std::ostringstream what;
-        what << "rigid impact zone of " << z.nodes.size() << " nodes still collides; holding it at its start "
-             << "position";
+        what << (carried ? "carried" : "rigid") << " impact zone of " << z.nodes.size()
+             << " nodes still collides; holding it at its start position";
         warn(params, what.str());
       }
       move_rigidly(z, target, g);

@@ -3,8 +3,9 @@
 // impact zones, and each zone is projected so that every impact's gap is at least the projection thickness
 // (zone_solver.hpp). Detection and projection repeat, zones growing and keeping their constraints, until the
 // motion is collision free. A zone that does not resolve within the iteration limit falls back to rigid motion
-// of its nodes with their mean displacement (and, if even that collides, to staying at x0), with a warning on
-// stderr: never to silent interpenetration.
+// of its nodes with their mean displacement; if even that collides, to moving with the obstacles it touches (when
+// they moved: held still, it would be run through), and last to staying at x0; each with a warning on stderr:
+// never to silent interpenetration.
 #pragma once
 
 #include <array>
@@ -49,10 +50,10 @@ struct ImpactZoneStats {
   int impacts = 0;           // impacts found in the first round
   int zones = 0;             // zones at the end
   int largest_zone = 0;      // nodes
-  int fallback_zones = 0;    // zones moved rigidly or held at x0
+  int fallback_zones = 0;    // zones moved rigidly, carried with obstacles or held at x0
   int ill_conditioned_zones = 0;  // projections refused as ill-conditioned (those zones also count as fallback)
   bool resolved = true;      // the final motion is collision free
-  // Nodes (geometry indices, sorted) of the zones moved rigidly or held at x0: their end positions are not the
+  // Nodes (geometry indices, sorted) of the zones on a fallback: their end positions are not the
   // physics' outcome, and the strain between them and their neighbours is not the material's.
   std::vector<int> fallback_nodes;
 };

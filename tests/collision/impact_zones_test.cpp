@@ -286,5 +286,38 @@ TEST(ImpactZones, InfeasibleZoneFallsBackWithWarning) {
   EXPECT_EQ(stats.fallback_nodes, (std::vector<int>{0, 1, 2, 3}));
 }
 
+// The same trapped sheet, but both plates move up by 1 mm during the step (an obstacle pressing on): held at its
+// start the sheet would be run through by the lower plate, so the zone moves with the plates it touches, keeps
+// its place between them, and the step ends collision free.
+TEST(ImpactZones, InfeasibleZoneAgainstMovingObstaclesIsCarriedWithThem) {
+  Mesh s = sheet(1, 0.1, 0, 0, 1e-3), lower = plate(0), upper = plate(0.5 * kH);
+  const Vec3 lift(0, 0, 1e-3);
+  for (Node& n : s.nodes) {
+    n.x0 = n.x + Vec3(0, 0, 0.25 * kH);
+    n.x = n.x + Vec3(0, 0, -0.01);
+  }
+  for (Mesh* p : {&lower, &upper})
+    for (Node& n : p->nodes) n.x = n.x0 + lift;
+  ContactGeometry g;
+  build_contact_geometry({{&s, true}, {&lower, false}, {&upper, false}}, ContactStage::kAfterStep, 1e-3, g);
+  ImpactZoneParams p = params();
+  p.max_iterations = 4;
+  BvhCache cache;
+  ::testing::internal::CaptureStderr();
+  const ImpactZoneStats stats = resolve_impacts(g, cache, p);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("moving it with the obstacle it touches"), std::string::npos) << err;
+  EXPECT_TRUE(stats.resolved) << err;
+  EXPECT_GE(stats.fallback_zones, 1);
+  // Between the plates where they ended (the zones that could be projected sit on the lower plate's gap; the
+  // trapped one, carried, where it was relative to both).
+  for (int n = 0; n < 4; ++n) {
+    EXPECT_GT(g.x1[n].z(), lift.z()) << "node " << n << err;
+    EXPECT_LT(g.x1[n].z(), lift.z() + 0.5 * kH) << "node " << n << err;
+  }
+  EXPECT_TRUE(detect_impacts(g, cache, params()).empty());
+  EXPECT_EQ(intersections(g, 0, 1) + intersections(g, 0, 2), 0);
+}
+
 }  // namespace
 }  // namespace arcsim
