@@ -60,7 +60,7 @@ void HandleLineKeeper::stage_done(EditKind kind, EditStage stage, const EditResu
   const int added = result.added_nodes[0];
   const std::array<int, 2> ends = mesh_.edges[result.removed_edges[0]].n;
   for (Handle& h : handles_) {
-    if (h.cloth != cloth_ || h.nodes.size() != h.anchors.size()) continue;
+    if (!h.holds_line || h.cloth != cloth_ || h.nodes.size() != h.anchors.size()) continue;
     const auto a = std::find(h.nodes.begin(), h.nodes.end(), ends[0]);
     const auto b = std::find(h.nodes.begin(), h.nodes.end(), ends[1]);
     if (a == h.nodes.end() || b == h.nodes.end()) continue;

@@ -36,8 +36,9 @@ RemeshStats refine_to_size_min(Cloth& cloth, const RemeshOptions& options);
 void remap_handles(std::vector<Handle>& handles, int cloth, const Mesh::Compaction& compaction);
 
 // Keeps the line a handle holds whole through edge splits: the node a split adds between two nodes of one
-// handle joins that handle, preserved, with its anchor interpolated as its position is. Registered as an
-// observer of every remeshing pass (frame ends, fracture's zones, the fixed high-resolution refinement).
+// line-holding handle (Handle::holds_line: chosen by label) joins that handle, preserved, with its anchor
+// interpolated as its position is. Registered as an observer of every remeshing pass (frame ends, fracture's
+// zones, the fixed high-resolution refinement).
 // WHY: a handle holds the nodes it was given; a split of a clamped border left the new middle node free, each
 // held node then pulled on the sheet like a point load, and a notched sheet pulled apart by clamps along two
 // borders tore along those borders before it tore at its notch.

@@ -150,6 +150,7 @@ void Simulation::load_handle(const HandleSpec& spec, int index) {
   h.start_time = spec.start_time;
   h.end_time = spec.end_time;
   h.fade_time = spec.fade_time;
+  h.holds_line = spec.label >= 0;
   Mesh& mesh = cloths[spec.cloth].mesh;
   if (spec.label >= 0) {
     for (size_t n = 0; n < mesh.nodes.size(); ++n)

@@ -50,6 +50,11 @@ struct Handle {
   std::vector<Vec3> anchors;    // positions the nodes are held at before the motion is applied (m)
   int motion = -1;
   double start_time = 0, end_time = kInfinity, fade_time = 0;
+  // Whether the handle holds a line rather than a list of points: a node remeshing adds between two of its
+  // nodes joins it (sim/remesh_cloth.hpp, HandleLineKeeper). True for handles chosen by label ("every node with
+  // that label": a split keeps a label both its ends share); false for node lists, which hold exactly the
+  // listed nodes, as in ARCSim.
+  bool holds_line = false;
   // Strength in [0, 1] at time t: 0 before start, 1 until end, then (1 - (t - end)/fade)^4 over fade_time.
   double strength(double t) const;
 };

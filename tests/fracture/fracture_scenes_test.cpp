@@ -117,6 +117,7 @@ void move_clamp(Simulation& sim, int h, const std::function<bool(const Vec3&)>& 
                 const std::function<Vec3(const Vec3&)>& place) {
   Handle& handle = sim.handles[h];
   Mesh& mesh = sim.cloths[0].mesh;
+  handle.holds_line = true;  // a clamp along a border: nodes remeshing adds on it within the step join it
   handle.nodes.clear();
   handle.anchors.clear();
   for (size_t n = 0; n < mesh.nodes.size(); ++n) {

@@ -175,14 +175,18 @@ void expect_top_edge_clamped(const Simulation& sim, double top, int least_nodes,
 }
 
 TEST(SimulationRemesh, AClampedEdgeStaysClampedWhereRefinementAddsNodes) {
-  const std::string path = temp_obj(testing::make_grid(4, 4, 0.5, 0.5), "clamped");
+  // The top row of the 5 x 5 node grid (y = 0.5) carries label 1; the handle chooses it by label.
+  Mesh grid = testing::make_grid(4, 4, 0.5, 0.5);
+  for (int n = 20; n <= 24; ++n) grid.nodes[n].label = 1;
+  const std::string path = temp_obj(grid, "clamped");
+  write_obj(grid, path);  // with its labels
   Scene scene = scene_with(path, cotton());
   scene.cloths[0].remeshing.size_min = 0.02;
   scene.cloths[0].remeshing.size_max = 0.06;  // the clamp's 0.125 m spacing is split at least twice
   scene.gravity = Vec3(0, 0, -9.8);
   scene.step_time = scene.frame_time = 5e-3;
   HandleSpec top;
-  top.nodes = {20, 21, 22, 23, 24};  // the top row of the 5 x 5 node grid, y = 0.5
+  top.label = 1;
   scene.handles.push_back(top);
   Simulation sim(scene);
   for (int frame = 0; frame < 6; ++frame) {
@@ -195,6 +199,24 @@ TEST(SimulationRemesh, AClampedEdgeStaysClampedWhereRefinementAddsNodes) {
   scene.magic.fixed_high_res_mesh = true;
   Simulation fixed(scene);
   expect_top_edge_clamped(fixed, 0.5, 17, "fixed_high_res_mesh");
+}
+
+// A handle given as a node list holds exactly those nodes, as in ARCSim: the nodes refinement adds between them
+// stay free.
+TEST(SimulationRemesh, ANodeListHandleHoldsOnlyItsNodes) {
+  const std::string path = temp_obj(testing::make_grid(4, 4, 0.5, 0.5), "listed");
+  Scene scene = scene_with(path, cotton());
+  scene.cloths[0].remeshing.size_min = 0.02;
+  scene.cloths[0].remeshing.size_max = 0.06;
+  scene.gravity = Vec3(0, 0, -9.8);
+  scene.step_time = scene.frame_time = 5e-3;
+  HandleSpec top;
+  top.nodes = {20, 21, 22, 23, 24};
+  scene.handles.push_back(top);
+  Simulation sim(scene);
+  for (int frame = 0; frame < 3; ++frame) sim.advance_frame();
+  EXPECT_GT(live_faces(sim.cloths[0].mesh), 32);  // refined
+  EXPECT_EQ(sim.handles[0].nodes.size(), 5u);
 }
 
 TEST(SimulationRemesh, FixedHighResMeshRefinesOnceAtStart) {
