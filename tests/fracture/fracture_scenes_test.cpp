@@ -340,8 +340,11 @@ TEST(FractureModeI, NotchedStripTearsStraightAcross) {
   };
   // Several loading rates: one rate alone gives one sample of a path that wanders by an element or two at the
   // slit's tip, where the fracture sizing refines the 4 mm cells to size_min. Before the clamps kept the nodes
-  // that remeshing adds between their nodes (sim/remesh_cloth.hpp, HandleLineKeeper), those nodes came loose,
-  // and the worst deviation at these four rates was 4.6, 3.5, 5.8 and 8.1 mm; with them held, 3.3 to 4.6 mm.
+  // that remeshing adds between their nodes within a step (Handle::holds_line, sim/remesh_cloth.hpp), those
+  // nodes were loose until the next step, and the worst deviation at these four rates was 4.6, 3.5, 5.8 and
+  // 8.1 mm; with them held, 3.3 to 4.6 mm. The fracture issue's acceptance asks for under 2 size_min (4 mm):
+  // not met at three of the four rates (a short side loop within 4 mm of the slit's tip); the bound here is
+  // the regression guard, 2.5 size_min.
   for (const double rate : {1.9e-6, 2.0e-6, 2.1e-6, 2.2e-6}) {  // m per side per step
     SCOPED_TRACE("opening " + std::to_string(rate * 1e6) + " um per step");
     StripSim run;
