@@ -9,6 +9,7 @@
 #include "io/errors.hpp"
 #include "physics/bending.hpp"
 #include "physics/plate_bending.hpp"
+#include "physics/system_premises.hpp"
 #include "physics/membrane.hpp"
 #include "physics/wind.hpp"
 
@@ -355,11 +356,11 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
 }
 
 VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,
-                      StepTiming& timing) {
+                      StepTiming& timing, const std::function<std::string()>& explain) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!solver.factorize(system))
-    throw NumericalError(step + ": the system matrix is not positive definite (CHOLMOD factorisation failed); "
-                         "the simulation is unstable");
+    throw NumericalError(step + ": the system matrix is not positive definite (CHOLMOD factorisation failed" +
+                         (explain ? ": " + explain() : std::string()) + "); the simulation is unstable");
   const auto t1 = std::chrono::steady_clock::now();
   VecX dv = solver.solve(system.rhs);
   if (!dv.allFinite()) throw NumericalError(step + ": velocity update is not finite");
@@ -388,7 +389,9 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
   }
   StepTiming times;
   times.assembly = seconds_since(t0);
-  const VecX dv = factor_and_solve(solver, system, "implicit step", times);
+  const VecX dv = factor_and_solve(solver, system, "implicit step", times, [&] {
+    return explain_indefinite_system(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system);
+  });
   for (int i = 0; i < n; ++i) {
     Node& node = mesh.nodes[i];
     node.v += dv.segment<3>(3 * i);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -126,9 +127,10 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
 
 // Factorises the assembled system and solves it for dv, adding the wall times to timing.factorization and
 // timing.solve. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the
-// matrix is not positive definite or dv is not finite.
+// matrix is not positive definite or dv is not finite; `explain`, if given, says why the matrix failed
+// (physics/system_premises.hpp) and is called only then.
 VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,
-                      StepTiming& timing);
+                      StepTiming& timing, const std::function<std::string()>& explain = {});
 
 // One implicit Euler step of size dt (s): solves for the velocity change, then v += dv, a = dv/dt, x0 = x,
 // x += v dt. Throws NumericalError if the system cannot be factorised or the result is not finite.

@@ -7,6 +7,7 @@
 
 #include "physics/face_element.hpp"
 #include "physics/system_dofs.hpp"
+#include "physics/system_premises.hpp"
 
 namespace arcsim {
 
@@ -131,7 +132,9 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
   system.reset(pattern);
   assemble_implicit_euler(mesh, faces, bending, dofs, loads, dt, system, options.linearisation);
   out.timing.assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const VecX dv = factor_and_solve(solver, system, "zone step", out.timing);
+  const VecX dv = factor_and_solve(solver, system, "zone step", out.timing, [&] {
+    return explain_indefinite_system(mesh, faces, bending, dofs, loads, dt, system);
+  });
 
   for (size_t i = 0; i < count; ++i) {
     const int d = dofs.dof(out.nodes[i]);
