@@ -74,6 +74,15 @@ std::string frame_log_line(const FrameReport& r) {
         .number("seconds", f.seconds);
     line.object("fracture", fracture);
   }
+  if (r.has_time_step) {
+    JsonLine step;
+    step.integer("substeps", r.substeps)
+        .integer("retries", r.retries)
+        .integer("level", r.substep_level)
+        .number("smallest", r.smallest_step);
+    if (!r.retry_cause.empty()) step.text("cause", r.retry_cause);
+    line.object("time_step", step);
+  }
   return line.str();
 }
 

@@ -38,6 +38,12 @@ struct FrameReport {
   ImpactZoneTotals impact_zones;     // summed over the frame's steps
   bool has_fracture = false;         // the fracture module ran in this frame: fracture below is meaningful
   FractureStats fracture;            // summed over the frame's steps and cloths
+  bool has_time_step = false;        // adaptive time stepping is on: the fields below are meaningful
+  int substeps = 0;                  // dynamics substeps taken in this frame
+  int retries = 0;                   // failed attempts redone with a smaller step
+  int substep_level = 0;             // the finest level used (substeps per step = 2^level)
+  double smallest_step = 0;          // s
+  std::string retry_cause;           // the last failure's cause ("" if none)
 };
 
 // {"frame":..,"time":..,"steps":..,"nodes":..,"faces":..,"saved":..,"wall":{"physics":..,...,"total":..}}, then
@@ -47,7 +53,8 @@ struct FrameReport {
 // then "impact_zones":{"steps":..,"impacts":..,"zones":..,"iterations":..,"largest_zone":..,"fallback_zones":..,
 // "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones, then "fracture":{"cracks":..,
 // "refused":..,"substeps":..,"candidates":..,"largest_zone":..,"remesh_edits":..,"max_ratio":..,"seconds":..}
-// when has_fracture (max_ratio: the largest separation strength / toughness seen at a step's first evaluation).
+// when has_fracture (max_ratio: the largest separation strength / toughness seen at a step's first evaluation),
+// then "time_step":{"substeps":..,"retries":..,"level":..,"smallest":..[,"cause":".."]} when has_time_step.
 std::string frame_log_line(const FrameReport& report);
 
 // {"frame":..,"total":..,"time":..,"faces":..,"nodes":..,"wall":..}; total is null when the run is unbounded,

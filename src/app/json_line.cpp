@@ -47,4 +47,23 @@ JsonLine& JsonLine::object(const char* name, const JsonLine& inner) {
   return *this;
 }
 
+JsonLine& JsonLine::text(const char* name, const std::string& value) {
+  key(name);
+  body_ += '"';
+  for (unsigned char c : value) {
+    if (c == '"' || c == '\\') {
+      body_ += '\\';
+      body_ += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      body_ += escaped;
+    } else {
+      body_ += static_cast<char>(c);
+    }
+  }
+  body_ += '"';
+  return *this;
+}
+
 }  // namespace arcsim

@@ -13,6 +13,8 @@ class JsonLine {
   JsonLine& integer(const char* key, long long x);
   JsonLine& boolean(const char* key, bool b);
   JsonLine& object(const char* key, const JsonLine& inner);
+  // A string value, escaped (quotes, backslashes and control characters).
+  JsonLine& text(const char* key, const std::string& value);
   std::string str() const { return "{" + body_ + "}"; }
 
  private:

@@ -47,6 +47,10 @@ std::string Progress::status(const FrameReport& r) const {
                 total.c_str(), r.time, r.faces, per_frame);
   std::string text = buffer;
   if (r.has_fracture) text += "  " + std::to_string(cracks_) + " cracks";
+  if (r.has_time_step && r.substep_level > 0) {
+    std::snprintf(buffer, sizeof buffer, "  step /%d", 1 << std::min(r.substep_level, 30));
+    text += buffer;
+  }
   if (bounded) text += "  ETA " + format_duration(per_frame * std::max(0.0, total_frames_ - r.frame));
   return text;
 }

@@ -158,6 +158,12 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   // Fracture ran in this frame if it is active now or was before passive_time switched it off in this frame.
   report.has_fracture = sim.scene().enabled("fracture") && !sim.fracture_stats.empty();
   for (const FractureStats& f : sim.fracture_stats) report.fracture += f;
+  report.has_time_step = sim.scene().adaptive_step.enabled;
+  report.substeps = sim.time_step_stats.substeps;
+  report.retries = sim.time_step_stats.retries;
+  report.substep_level = sim.time_step_stats.level;
+  report.smallest_step = sim.time_step_stats.smallest;
+  report.retry_cause = sim.time_step_stats.cause;
 }
 
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {

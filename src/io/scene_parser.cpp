@@ -438,6 +438,28 @@ class SceneParser {
                            "save_frames, save_every, duration)");
     }
     scene_.passive_time = get_real(top.get("passive_time"), kInfinity, or_infinite(kNonNegative));
+    parse_adaptive_step(top.get("adaptive_time_step"));
+  }
+
+  // `adaptive_time_step`: true, false, or an object of settings (an object turns it on unless "enabled": false).
+  void parse_adaptive_step(const Found& f) {
+    AdaptiveStepSpec& a = scene_.adaptive_step;
+    if (!f) return;
+    if (f.value->isBool()) {
+      a.enabled = f.value->asBool();
+    } else {
+      ObjectReader r(*f.value, f.at, scene_.warnings);
+      a.enabled = get_bool(r.get("enabled"), true);
+      a.min_step = get_real(r.get("min_step"), 0, kNonNegative);
+      a.max_motion = get_real(r.get("max_motion"), kInfinity, or_infinite(kPositive));
+      a.reject_fallbacks = get_bool(r.get("reject_fallbacks"), true);
+      a.grow_after = get_int(r.get("grow_after"), 8, 1);
+      r.warn_unknown();
+    }
+    if (a.min_step == 0) a.min_step = scene_.step_time / 1024;
+    if (a.enabled && a.min_step > scene_.step_time)
+      fail(f.at.key("min_step"), "must not exceed the scene's time step (" + number(scene_.step_time) + " s), got " +
+                                     number(a.min_step));
   }
 
   // --- modules and tunables ----------------------------------------------------------------------------------

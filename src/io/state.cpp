@@ -153,6 +153,7 @@ struct StagedHandle {
 struct StagedState {
   double time = 0;
   int64_t step = 0, frame = 0;
+  int32_t substep_level = 0, steps_at_substep_level = 0;  // STEP (adaptive time stepping), 0 if absent
   std::vector<StagedCloth> cloths;
   std::vector<StagedObstacle> obstacles;
   std::vector<StagedHandle> handles;
@@ -351,11 +352,28 @@ void read_handles(StateReader& r, StagedState& s) {
   }
 }
 
+// Adaptive time stepping's level (sim/simulation.hpp): written only by scenes that turn it on.
+void write_substep_level(const Simulation& sim, StateWriter& w) {
+  w.put_i32(sim.substep_level());
+  w.put_i32(sim.steps_at_substep_level());
+}
+
+void read_substep_level(StateReader& r, StagedState& s) {
+  s.substep_level = r.get_i32();
+  s.steps_at_substep_level = r.get_i32();
+  if (s.substep_level < 0 || s.substep_level > Simulation::kMaxSubstepLevel)
+    r.fail("substep level " + std::to_string(s.substep_level) + " is out of range");
+  if (s.steps_at_substep_level < 0) r.fail("negative step count " + std::to_string(s.steps_at_substep_level));
+}
+
+bool adaptive_stepping(const Simulation& sim) { return sim.scene().adaptive_step.enabled; }
+
 struct SectionCodec {
   const char* tag;  // exactly 4 ASCII characters
   bool required;
   void (*write)(const Simulation&, StateWriter&);
   void (*read)(StateReader&, StagedState&);
+  bool (*present)(const Simulation&) = nullptr;  // optional sections: whether this simulation writes it
 };
 
 // Written in this order; read in file order (the staged state is only checked once every section is in).
@@ -364,6 +382,7 @@ const SectionCodec kSections[] = {
     {"CLTH", true, write_cloths, read_cloths},
     {"OBST", true, write_obstacles, read_obstacles},
     {"HNDL", true, write_handles, read_handles},
+    {"STEP", false, write_substep_level, read_substep_level, adaptive_stepping},
 };
 
 // ---------------------------------------------------------------------------------------------------------
@@ -482,6 +501,7 @@ void check_staged(const StagedState& s, const Simulation& sim, const std::string
 
 void commit(StagedState& s, Simulation& sim) {
   sim.restore_clock(s.time, static_cast<int>(s.step), static_cast<int>(s.frame));
+  sim.restore_substep_level(s.substep_level, s.steps_at_substep_level);
   for (size_t c = 0; c < s.cloths.size(); ++c) {
     Cloth& cloth = sim.cloths[c];
     cloth.mesh = std::move(s.cloths[c].mesh);
@@ -526,10 +546,13 @@ uint64_t decode_u64(const char* p) {
 
 std::string encode_state(const Simulation& sim) {
   std::vector<std::string> payloads;
+  std::vector<const SectionCodec*> written;
   for (const SectionCodec& codec : kSections) {
+    if (codec.present && !codec.present(sim)) continue;
     StateWriter w;
     codec.write(sim, w);
     payloads.push_back(w.take());
+    written.push_back(&codec);
   }
   const size_t count = payloads.size();
   size_t total = kHeaderBytes + count * kTableEntryBytes + kChecksumBytes;
@@ -542,7 +565,7 @@ std::string encode_state(const Simulation& sim) {
   append_u32(out, static_cast<uint32_t>(count));
   append_u64(out, total);
   for (size_t i = 0; i < count; ++i) {
-    out.append(kSections[i].tag, 4);
+    out.append(written[i]->tag, 4);
     append_u64(out, payloads[i].size());
   }
   for (const std::string& p : payloads) out += p;

@@ -16,6 +16,9 @@
 //         floating-point sums, so rebuilding them would break bit-identity)
 //   OBST  per obstacle: node positions x, x0, velocities v, and `active`
 //   HNDL  per handle: cloth, node indices, anchors
+// Optional sections (written only where they apply):
+//   STEP  adaptive time stepping's substep level and the steps taken at it (two int32), in scenes that turn
+//         adaptive_time_step on
 // Later modules add their state (collision history, remeshing reference, fracture flags, random generator)
 // as new tagged sections in state.cpp; a reader that meets a tag it does not know refuses the file, naming it.
 #pragma once

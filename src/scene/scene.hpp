@@ -101,6 +101,19 @@ struct FractureSpec {
   int virtual_iterations = 4;  // Newton iterations of the virtual update (1: one linearised step)
 };
 
+// Adaptive time stepping (scene key `adaptive_time_step`; off unless given, so ARCSim's scenes keep their
+// meaning). A step whose dynamics (proximity, implicit solve, collision response) fails is redone from its start
+// as 2, 4, 8, ... substeps, down to min_step; after grow_after steps that succeed at a level, the next step tries
+// one level coarser. Plasticity, fracture and remeshing still run once per scene step.
+struct AdaptiveStepSpec {
+  bool enabled = false;
+  double min_step = 0;             // s; 0: the scene's step / 1024
+  double max_motion = kInfinity;   // m: a substep in which a cloth node moves farther fails
+  bool reject_fallbacks = true;    // a substep whose collision response needed a fallback (rigid, carried or
+                                   // held impact zones) fails
+  int grow_after = 8;              // steps at a level before a coarser one is tried
+};
+
 struct Scene {
   std::string path;             // the scene file
   std::string base_dir;         // folder paths are resolved against first
@@ -112,6 +125,7 @@ struct Scene {
   double end_frame = kInfinity;
   int save_every = 1;
   double passive_time = kInfinity;
+  AdaptiveStepSpec adaptive_step;
   std::vector<ClothSpec> cloths;
   std::vector<Motion> motions;
   std::vector<HandleSpec> handles;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
 #include <sstream>
 
 #include "fracture/fracture_sizing.hpp"
@@ -305,14 +306,46 @@ double Simulation::current_step_time() const { return passive() ? kPassiveStepFa
 
 void Simulation::advance_step() {
   const double dt = current_step_time();
+  const double start = time_;
   time_ += dt;
   ++step_;
+  if ((step_ - 1) % frame_steps_ == 0) time_step_stats = TimeStepStats();
   jitter_step();
-  move_obstacles(time_);
 
   // Proximity forces enter the implicit solve; the impact-zone response follows the position update.
   refresh_elements();
   audit(&StepEnergies::start);
+  double dynamics_dt = dt;
+  if (scene_.adaptive_step.enabled) {
+    dynamics_dt = adaptive_dynamics_step(start, dt);
+  } else {
+    move_obstacles(time_);
+    dynamics_step(dt);
+    ++time_step_stats.substeps;
+    time_step_stats.smallest = time_step_stats.smallest > 0 ? std::min(time_step_stats.smallest, dt) : dt;
+  }
+
+  auto t0 = std::chrono::steady_clock::now();
+  plasticity_step(dt);
+  times.plasticity += seconds_since(t0);
+  audit(&StepEnergies::after_plasticity, true);
+
+  // Fracture's virtual update relaxes the last (sub)step: its contacts and displacements are that step's.
+  t0 = std::chrono::steady_clock::now();
+  fracture_step(dynamics_dt);
+  times.fracture += seconds_since(t0);
+  audit(&StepEnergies::after_fracture, true);
+
+  if (step_ % frame_steps_ == 0) {
+    t0 = std::chrono::steady_clock::now();
+    remeshing_step();
+    times.remeshing += seconds_since(t0);
+    ++frame_;
+  }
+  audit(&StepEnergies::after_remeshing, true);
+}
+
+void Simulation::dynamics_step(double dt) {
   auto t0 = std::chrono::steady_clock::now();
   step_contacts_.clear();
   step_fallback_nodes_.clear();
@@ -335,24 +368,116 @@ void Simulation::advance_step() {
   times.collision += seconds_since(t0);
   check_state();
   audit(&StepEnergies::after_collision);
+}
 
-  t0 = std::chrono::steady_clock::now();
-  plasticity_step(dt);
-  times.plasticity += seconds_since(t0);
-  audit(&StepEnergies::after_plasticity, true);
+namespace {
 
-  t0 = std::chrono::steady_clock::now();
-  fracture_step(dt);
-  times.fracture += seconds_since(t0);
-  audit(&StepEnergies::after_fracture, true);
+// The node state the dynamics change (positions, start positions, velocities, accelerations), per cloth.
+struct DynamicsSnapshot {
+  std::vector<std::vector<std::array<Vec3, 4>>> nodes;
+};
 
-  if (step_ % frame_steps_ == 0) {
-    t0 = std::chrono::steady_clock::now();
-    remeshing_step();
-    times.remeshing += seconds_since(t0);
-    ++frame_;
+DynamicsSnapshot take_snapshot(const std::vector<Cloth>& cloths) {
+  DynamicsSnapshot s;
+  s.nodes.resize(cloths.size());
+  for (size_t c = 0; c < cloths.size(); ++c)
+    for (const Node& n : cloths[c].mesh.nodes) s.nodes[c].push_back({n.x, n.x0, n.v, n.a});
+  return s;
+}
+
+void restore_snapshot(const DynamicsSnapshot& s, std::vector<Cloth>& cloths) {
+  for (size_t c = 0; c < cloths.size(); ++c)
+    for (size_t i = 0; i < s.nodes[c].size(); ++i) {
+      Node& n = cloths[c].mesh.nodes[i];
+      n.x = s.nodes[c][i][0];
+      n.x0 = s.nodes[c][i][1];
+      n.v = s.nodes[c][i][2];
+      n.a = s.nodes[c][i][3];
+    }
+}
+
+std::string seconds_text(double s) {
+  std::ostringstream out;
+  out << s << " s";
+  return out.str();
+}
+
+}  // namespace
+
+std::string Simulation::substep_problem(double dt) const {
+  const AdaptiveStepSpec& a = scene_.adaptive_step;
+  if (a.reject_fallbacks)
+    for (size_t c = 0; c < step_fallback_nodes_.size(); ++c)
+      if (!step_fallback_nodes_[c].empty())
+        return "the collision response of cloth " + std::to_string(c) + " needed a fallback (" +
+               std::to_string(step_fallback_nodes_[c].size()) + " nodes moved rigidly or held)";
+  if (a.max_motion < kInfinity)
+    for (size_t c = 0; c < cloths.size(); ++c)
+      for (size_t i = 0; i < cloths[c].mesh.nodes.size(); ++i) {
+        const Node& n = cloths[c].mesh.nodes[i];
+        const double moved = (n.x - n.x0).norm();
+        if (moved > a.max_motion) {
+          std::ostringstream what;
+          what << "cloth " << c << " node " << i + 1 << " moved " << moved << " m in a substep of " << dt
+               << " s (max_motion " << a.max_motion << " m)";
+          return what.str();
+        }
+      }
+  return "";
+}
+
+double Simulation::adaptive_dynamics_step(double start, double dt) {
+  const AdaptiveStepSpec& a = scene_.adaptive_step;
+  const DynamicsSnapshot snapshot = take_snapshot(cloths);
+  for (;;) {
+    const int substeps = 1 << substep_level_;
+    const double h = dt / substeps;
+    std::string problem;
+    std::vector<std::vector<int>> fallback_nodes(cloths.size());
+    try {
+      // Obstacles start the step where they were at its start (a retried step finds them moved on).
+      move_obstacles(start);
+      for (int k = 0; k < substeps && problem.empty(); ++k) {
+        time_ = k + 1 == substeps ? start + dt : start + (k + 1) * h;
+        move_obstacles(time_);
+        dynamics_step(h);
+        problem = substep_problem(h);
+        for (size_t c = 0; c < step_fallback_nodes_.size() && c < cloths.size(); ++c)
+          fallback_nodes[c].insert(fallback_nodes[c].end(), step_fallback_nodes_[c].begin(),
+                                   step_fallback_nodes_[c].end());
+      }
+    } catch (const NumericalError& e) {
+      problem = e.what();
+    }
+    if (problem.empty()) {
+      for (auto& nodes : fallback_nodes) {
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+      }
+      step_fallback_nodes_ = std::move(fallback_nodes);
+      time_step_stats.substeps += substeps;
+      time_step_stats.smallest = time_step_stats.smallest > 0 ? std::min(time_step_stats.smallest, h) : h;
+      time_step_stats.level = std::max(time_step_stats.level, substep_level_);
+      if (substep_level_ > 0 && ++steps_at_level_ >= a.grow_after) {
+        --substep_level_;
+        steps_at_level_ = 0;
+      }
+      return h;
+    }
+    restore_snapshot(snapshot, cloths);
+    time_ = start + dt;
+    ++time_step_stats.retries;
+    time_step_stats.cause = problem;
+    if (!(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel) {
+      std::ostringstream what;
+      what << "step " << step_ << " (t = " << start << " to " << start + dt << " s) failed at the smallest substep "
+           << seconds_text(h) << " (adaptive_time_step.min_step " << seconds_text(a.min_step) << "): " << problem
+           << "; try a smaller min_step or time step";
+      throw NumericalError(what.str());
+    }
+    ++substep_level_;
+    steps_at_level_ = 0;
   }
-  audit(&StepEnergies::after_remeshing, true);
 }
 
 void Simulation::audit(double StepEnergies::*phase, bool fresh_elements) {

@@ -127,6 +127,24 @@ class Simulation {
   // Per cloth, what fracture substepping did in the steps of the current frame so far (reset at each frame's
   // first step, like plastic_work).
   std::vector<FractureStats> fracture_stats;
+  // What the time stepping did in the steps of the current frame so far (reset at each frame's first step):
+  // dynamics substeps run, failed attempts redone with a smaller step (adaptive_time_step), the smallest substep
+  // (s), the finest level (substeps = 2^level), and the last failure's cause.
+  struct TimeStepStats {
+    int substeps = 0, retries = 0, level = 0;
+    double smallest = 0;
+    std::string cause;
+  };
+  TimeStepStats time_step_stats;
+  // Adaptive time stepping's state (saved in state files so that a resumed run continues identically): the
+  // current level (each step as 2^level substeps) and the steps that succeeded at it.
+  int substep_level() const { return substep_level_; }
+  int steps_at_substep_level() const { return steps_at_level_; }
+  void restore_substep_level(int level, int steps) {
+    substep_level_ = level;
+    steps_at_level_ = steps;
+  }
+  static constexpr int kMaxSubstepLevel = 20;
   // Fracture parameters (from the scene; tests and the ablations of tools/ change them).
   FractureParams fracture;
   // Whether the fracture module runs at the current time: enabled in the scene, and before passive_time
@@ -166,6 +184,14 @@ class Simulation {
   // The implicit step of every cloth with its loads and step_contacts_.
   void physics_step(double dt);
   void collision_step(double dt);
+  // Proximity, the implicit step and the collision response over dt, ending at time_ (obstacles already moved).
+  void dynamics_step(double dt);
+  // The dynamics of the step [start, start + dt] with adaptive time stepping: as 2^level substeps, redone from
+  // the step's start one level finer whenever a substep fails (NumericalError, substep_problem). Returns the
+  // last substep's size. Throws NumericalError when the step fails at min_step.
+  double adaptive_dynamics_step(double start, double dt);
+  // Why the substep just taken fails adaptive_time_step's checks ("" if it does not).
+  std::string substep_problem(double dt) const;
   // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
   void jitter_step();
   void plasticity_step(double dt);
@@ -197,6 +223,8 @@ class Simulation {
   // This step's nodes per cloth that the collision response moved by a fallback (fracture does not trust
   // their strain; FractureContext::untrusted_nodes).
   std::vector<std::vector<int>> step_fallback_nodes_;
+  int substep_level_ = 0;
+  int steps_at_level_ = 0;
 };
 
 }  // namespace arcsim

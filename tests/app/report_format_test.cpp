@@ -82,6 +82,26 @@ TEST(FrameLog, ImpactZoneStatisticsWhenCollisionsRan) {
   EXPECT_FALSE(parse(frame_log_line(r)).isMember("impact_zones"));
 }
 
+TEST(FrameLog, TimeStepStatisticsWhenAdaptive) {
+  FrameReport r;
+  EXPECT_FALSE(parse(frame_log_line(r)).isMember("time_step"));
+  r.has_time_step = true;
+  r.substeps = 36;
+  r.retries = 2;
+  r.substep_level = 3;
+  r.smallest_step = 1.25e-3;
+  r.retry_cause = "cloth 0 \"node\" 7\\ moved\tfar";
+  const Json::Value t = parse(frame_log_line(r))["time_step"];
+  ASSERT_TRUE(t.isObject());
+  EXPECT_EQ(t["substeps"].asInt(), 36);
+  EXPECT_EQ(t["retries"].asInt(), 2);
+  EXPECT_EQ(t["level"].asInt(), 3);
+  EXPECT_EQ(t["smallest"].asDouble(), 1.25e-3);
+  EXPECT_EQ(t["cause"].asString(), r.retry_cause);  // quotes, backslashes and control characters escaped
+  r.retry_cause.clear();
+  EXPECT_FALSE(parse(frame_log_line(r))["time_step"].isMember("cause"));
+}
+
 TEST(FrameLog, MeshSizesPerCloth) {
   FrameReport r;
   r.meshes.push_back({200, 0.01, 0.02, 0.05});

@@ -188,6 +188,30 @@ TEST(SceneParser, TimingStyleB) {
   EXPECT_TRUE(s.warnings.empty());
 }
 
+// adaptive_time_step: off unless given; `true` or an object turns it on with min_step = step / 1024 by default.
+TEST(SceneParser, AdaptiveTimeStep) {
+  const Scene off = SceneFixture(base_scene()).load();
+  EXPECT_FALSE(off.adaptive_step.enabled);
+  Json::Value j = base_scene();
+  j["adaptive_time_step"] = true;
+  const Scene on = SceneFixture(j).load();
+  EXPECT_TRUE(on.adaptive_step.enabled);
+  EXPECT_DOUBLE_EQ(on.adaptive_step.min_step, 0.01 / 1024);
+  EXPECT_EQ(on.adaptive_step.max_motion, kInfinity);
+  EXPECT_TRUE(on.adaptive_step.reject_fallbacks);
+  j["adaptive_time_step"] = parse_text(R"({"min_step": 1e-5, "max_motion": 0.002, "reject_fallbacks": false,
+                                           "grow_after": 3})");
+  const Scene set = SceneFixture(j).load();
+  EXPECT_TRUE(set.adaptive_step.enabled);
+  EXPECT_DOUBLE_EQ(set.adaptive_step.min_step, 1e-5);
+  EXPECT_DOUBLE_EQ(set.adaptive_step.max_motion, 0.002);
+  EXPECT_FALSE(set.adaptive_step.reject_fallbacks);
+  EXPECT_EQ(set.adaptive_step.grow_after, 3);
+  EXPECT_TRUE(set.warnings.empty());
+  j["adaptive_time_step"] = parse_text(R"({"enabled": false, "min_step": 1e-5})");
+  EXPECT_FALSE(SceneFixture(j).load().adaptive_step.enabled);
+}
+
 TEST(SceneParser, StyleAIgnoresDurationWithWarning) {
   Json::Value j = base_scene();
   j.removeMember("end_time");
@@ -365,6 +389,16 @@ const std::vector<BadCase>& bad_cases() {
       {"aspect_above_one", [](Json::Value& j) { remeshing0(j)["aspect_min"] = 2; }, "cloths[0].remeshing.aspect_min",
        "must be in [0, 1]"},
       {"no_cloths", [](Json::Value& j) { j.removeMember("cloths"); }, "cloths", "required"},
+      {"adaptive_not_object", [](Json::Value& j) { j["adaptive_time_step"] = 3; }, "adaptive_time_step",
+       "must be an object"},
+      {"adaptive_min_step_negative", [](Json::Value& j) { j["adaptive_time_step"]["min_step"] = -1e-3; },
+       "adaptive_time_step.min_step", "must be >= 0"},
+      {"adaptive_min_step_above_step", [](Json::Value& j) { j["adaptive_time_step"]["min_step"] = 0.02; },
+       "adaptive_time_step.min_step", "must not exceed the scene's time step (0.01 s)"},
+      {"adaptive_max_motion_zero", [](Json::Value& j) { j["adaptive_time_step"]["max_motion"] = 0; },
+       "adaptive_time_step.max_motion", "must be > 0"},
+      {"adaptive_grow_after_zero", [](Json::Value& j) { j["adaptive_time_step"]["grow_after"] = 0; },
+       "adaptive_time_step.grow_after", ">= 1"},
   };
   return cases;
 }
