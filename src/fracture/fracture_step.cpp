@@ -246,6 +246,33 @@ std::vector<int> remesh_zone(Mesh& mesh, const std::vector<Material>& materials,
   return nodes;
 }
 
+// Grows the zone (sorted nodes) by rings while a face of its support ring is stressed past
+// params.support_stress times its toughness, at the current positions (FractureParams::max_zone_rings).
+std::vector<int> grow_to_calm_support(const Mesh& mesh, const std::vector<Material>& materials,
+                                      std::vector<int> zone, const FractureParams& params,
+                                      std::vector<FaceFractureStress>& stress) {
+  for (int rings = std::max(params.zone_rings, 0); rings < params.max_zone_rings; ++rings) {
+    const std::vector<int> grown = node_rings(mesh, zone, 1);
+    std::vector<int> support;
+    std::set_difference(grown.begin(), grown.end(), zone.begin(), zone.end(), std::back_inserter(support));
+    if (support.empty()) break;
+    const std::vector<int> faces = faces_of_nodes(mesh, support);
+    update_fracture_stresses(mesh, materials, faces, stress);
+    bool stressed = false;
+    for (int f : faces) {
+      const Face& face = mesh.faces[f];
+      const double tau = face_toughness(face, materials[face.material]);
+      if (tau > 0 && stress[f].lambda_max > params.support_stress * tau) {
+        stressed = true;
+        break;
+      }
+    }
+    if (!stressed) break;
+    zone = grown;
+  }
+  return zone;
+}
+
 // Steps 2c-d: the breaking nodes of the zone at the positions a zone step predicts, positions rewound. When the
 // zone's system cannot be solved the prediction is skipped (the stress at the current positions decides).
 std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone,
@@ -416,12 +443,14 @@ FractureStats fracture_step(Mesh& mesh, const std::vector<Material>& materials, 
   } else {
     std::vector<int> zone;
     for (const Candidate& c : candidates) zone.push_back(c.separation.node);
+    std::vector<FaceFractureStress> support_stress;  // scratch of grow_to_calm_support
     const bool remesh_locally = params.local_remesh && size_min_of(context) > 0;
     // Every iteration opens a crack or refuses a node for the rest of the step: bounded.
     const int max_iterations = 2 * params.max_cracks + 16;
     while (!zone.empty() && stats.cracks < params.max_cracks && stats.substeps < max_iterations) {
       ++stats.substeps;
       std::vector<int> zone_nodes = node_rings(mesh, zone, std::max(params.zone_rings, 0));
+      zone_nodes = grow_to_calm_support(mesh, materials, std::move(zone_nodes), params, support_stress);
       if (remesh_locally) zone_nodes = remesh_zone(mesh, materials, zone_nodes, context, pass, stats);
       stats.largest_zone = std::max(stats.largest_zone, static_cast<int>(zone_nodes.size()));
       candidates = predict(mesh, materials, zone_nodes, params, context, pass, zone_solver, stress, refused);

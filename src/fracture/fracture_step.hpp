@@ -54,6 +54,12 @@ namespace arcsim {
 
 struct FractureParams {
   int zone_rings = 3;        // n of Algorithm 1 (at least 2 relieve bending stress, paper §4.1)
+  // The zone then grows ring by ring, up to max_zone_rings in all, while its support (the ring the virtual
+  // update holds fixed) touches a face whose sigma+ exceeds support_stress times its toughness: a support held
+  // in material that is itself past breaking imposes that state on the prediction, which then cannot relax
+  // it (a collision response's projection at a large time step strains a stiff sheet over many rings).
+  int max_zone_rings = 3;
+  double support_stress = 1.0;
   int max_cracks = 100;      // openings per step and cloth (magic.max_cracks)
   bool substepping = true;   // Algorithm 1; false: the ablation described above
   bool local_remesh = true;  // step 2b (needs the remeshing module and a finite size_min)

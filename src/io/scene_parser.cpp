@@ -511,6 +511,8 @@ class SceneParser {
     FractureSpec& s = scene_.fracture;
     ObjectReader r(*f.value, f.at, scene_.warnings);
     s.zone_rings = get_int(r.get("zone_rings"), s.zone_rings, 1, 20);
+    s.max_zone_rings = get_int(r.get("max_zone_rings"), std::max(s.max_zone_rings, s.zone_rings), s.zone_rings, 40);
+    s.support_stress = get_real(r.get("support_stress"), s.support_stress, kPositive);
     s.substepping = get_bool(r.get("substepping"), s.substepping);
     s.local_remesh = get_bool(r.get("local_remesh"), s.local_remesh);
     s.reproject = get_bool(r.get("reproject"), s.reproject);

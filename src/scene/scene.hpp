@@ -91,6 +91,8 @@ struct MagicParams {
 // as in ARCSim.
 struct FractureSpec {
   int zone_rings = 3;         // n-ring of Algorithm 1's zone
+  int max_zone_rings = 3;     // rings the zone may grow to while its support is stressed past support_stress tau
+  double support_stress = 1.0;
   bool substepping = true;    // false: the paper's ablation (one evaluation, no virtual update)
   bool local_remesh = true;   // refine the zone to size_min before predicting
   bool reproject = true;      // Eq. 13 after each opening

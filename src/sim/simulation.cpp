@@ -40,6 +40,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   end_time_ = scene.end_time;
   end_frame_ = scene.end_frame;
   fracture.zone_rings = scene.fracture.zone_rings;
+  fracture.max_zone_rings = scene.fracture.max_zone_rings;
+  fracture.support_stress = scene.fracture.support_stress;
   fracture.substepping = scene.fracture.substepping;
   fracture.local_remesh = scene.fracture.local_remesh;
   fracture.reproject = scene.fracture.reproject;

@@ -397,6 +397,11 @@ const std::vector<BadCase>& bad_cases() {
        "adaptive_time_step.min_step", "must not exceed the scene's time step (0.01 s)"},
       {"adaptive_max_motion_zero", [](Json::Value& j) { j["adaptive_time_step"]["max_motion"] = 0; },
        "adaptive_time_step.max_motion", "must be > 0"},
+      {"fracture_max_rings_below_rings", [](Json::Value& j) { j["fracture"] = parse_text(R"({"zone_rings": 5,
+                                                                                            "max_zone_rings": 4})"); },
+       "fracture.max_zone_rings", "in [5, 40]"},
+      {"fracture_support_stress_zero", [](Json::Value& j) { j["fracture"]["support_stress"] = 0; },
+       "fracture.support_stress", "must be > 0"},
       {"adaptive_grow_after_zero", [](Json::Value& j) { j["adaptive_time_step"]["grow_after"] = 0; },
        "adaptive_time_step.grow_after", ">= 1"},
   };
