@@ -452,6 +452,7 @@ class SceneParser {
       a.enabled = get_bool(r.get("enabled"), true);
       a.min_step = get_real(r.get("min_step"), 0, kNonNegative);
       a.max_motion = get_real(r.get("max_motion"), kInfinity, or_infinite(kPositive));
+      a.max_correction = get_real(r.get("max_correction"), kInfinity, or_infinite(kPositive));
       a.reject_fallbacks = get_bool(r.get("reject_fallbacks"), true);
       a.grow_after = get_int(r.get("grow_after"), 8, 1);
       r.warn_unknown();

@@ -111,6 +111,8 @@ struct AdaptiveStepSpec {
   bool enabled = false;
   double min_step = 0;             // s; 0: the scene's step / 1024
   double max_motion = kInfinity;   // m: a substep in which a cloth node moves farther fails
+  double max_correction = kInfinity;  // m: a substep in which the collision response moves a cloth node farther
+                                      // fails (its projection strains a stiff sheet by about that / edge length)
   bool reject_fallbacks = true;    // a substep whose collision response needed a fallback (rigid, carried or
                                    // held impact zones) fails
   int grow_after = 8;              // steps at a level before a coarser one is tried

@@ -365,9 +365,28 @@ void Simulation::dynamics_step(double dt) {
   check_state();
   audit(&StepEnergies::after_physics);
 
+  // The collision response's largest correction, for adaptive_time_step.max_correction.
+  const bool measure = scene_.adaptive_step.enabled && scene_.adaptive_step.max_correction < kInfinity;
+  std::vector<std::vector<Vec3>> after_physics;
+  if (measure)
+    for (const Cloth& cloth : cloths) {
+      after_physics.emplace_back();
+      for (const Node& n : cloth.mesh.nodes) after_physics.back().push_back(n.x);
+    }
   t0 = std::chrono::steady_clock::now();
   if (scene_.enabled("collision")) collision_step(dt);
   times.collision += seconds_since(t0);
+  step_correction_ = 0;
+  step_correction_at_ = {-1, -1};
+  if (measure)
+    for (size_t c = 0; c < cloths.size(); ++c)
+      for (size_t i = 0; i < after_physics[c].size(); ++i) {
+        const double moved = (cloths[c].mesh.nodes[i].x - after_physics[c][i]).norm();
+        if (moved > step_correction_) {
+          step_correction_ = moved;
+          step_correction_at_ = {static_cast<int>(c), static_cast<int>(i)};
+        }
+      }
   check_state();
   audit(&StepEnergies::after_collision);
 }
@@ -413,6 +432,13 @@ std::string Simulation::substep_problem(double dt) const {
       if (!step_fallback_nodes_[c].empty())
         return "the collision response of cloth " + std::to_string(c) + " needed a fallback (" +
                std::to_string(step_fallback_nodes_[c].size()) + " nodes moved rigidly or held)";
+  if (step_correction_ > a.max_correction) {
+    std::ostringstream what;
+    what << "the collision response moved cloth " << step_correction_at_[0] << " node " << step_correction_at_[1] + 1
+         << " by " << step_correction_ << " m in a substep of " << dt << " s (max_correction " << a.max_correction
+         << " m)";
+    return what.str();
+  }
   if (a.max_motion < kInfinity)
     for (size_t c = 0; c < cloths.size(); ++c)
       for (size_t i = 0; i < cloths[c].mesh.nodes.size(); ++i) {

@@ -4,6 +4,7 @@
 // fracture substepping, and remeshing at frame ends.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -225,6 +226,10 @@ class Simulation {
   std::vector<std::vector<int>> step_fallback_nodes_;
   int substep_level_ = 0;
   int steps_at_level_ = 0;
+  // With adaptive_time_step: how far the last dynamics step's collision response moved a cloth node (m), and
+  // which (cloth, node).
+  double step_correction_ = 0;
+  std::array<int, 2> step_correction_at_{-1, -1};
 };
 
 }  // namespace arcsim

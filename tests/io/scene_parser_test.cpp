@@ -200,13 +200,14 @@ TEST(SceneParser, AdaptiveTimeStep) {
   EXPECT_EQ(on.adaptive_step.max_motion, kInfinity);
   EXPECT_TRUE(on.adaptive_step.reject_fallbacks);
   j["adaptive_time_step"] = parse_text(R"({"min_step": 1e-5, "max_motion": 0.002, "reject_fallbacks": false,
-                                           "grow_after": 3})");
+                                           "grow_after": 3, "max_correction": 1e-4})");
   const Scene set = SceneFixture(j).load();
   EXPECT_TRUE(set.adaptive_step.enabled);
   EXPECT_DOUBLE_EQ(set.adaptive_step.min_step, 1e-5);
   EXPECT_DOUBLE_EQ(set.adaptive_step.max_motion, 0.002);
   EXPECT_FALSE(set.adaptive_step.reject_fallbacks);
   EXPECT_EQ(set.adaptive_step.grow_after, 3);
+  EXPECT_DOUBLE_EQ(set.adaptive_step.max_correction, 1e-4);
   EXPECT_TRUE(set.warnings.empty());
   j["adaptive_time_step"] = parse_text(R"({"enabled": false, "min_step": 1e-5})");
   EXPECT_FALSE(SceneFixture(j).load().adaptive_step.enabled);
@@ -402,6 +403,8 @@ const std::vector<BadCase>& bad_cases() {
        "fracture.max_zone_rings", "in [5, 40]"},
       {"fracture_support_stress_zero", [](Json::Value& j) { j["fracture"]["support_stress"] = 0; },
        "fracture.support_stress", "must be > 0"},
+      {"adaptive_max_correction_negative", [](Json::Value& j) { j["adaptive_time_step"]["max_correction"] = -1; },
+       "adaptive_time_step.max_correction", "must be > 0"},
       {"adaptive_grow_after_zero", [](Json::Value& j) { j["adaptive_time_step"]["grow_after"] = 0; },
        "adaptive_time_step.grow_after", ">= 1"},
   };
