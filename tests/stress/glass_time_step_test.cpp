@@ -17,6 +17,7 @@
 #include "collision/scene_fixtures.hpp"
 #include "io/scene_parser.hpp"
 #include "stress/repository.hpp"
+#include "support/files.hpp"
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
 
@@ -25,6 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace testing;
+using arcsim::testing::TempDir;
 
 std::string glass_plate_scene(const fs::path& root, const std::string& step) {
   const std::string square = (root / "meshes/square.obj").string(), ground = (root / "meshes/ground.obj").string();
@@ -42,6 +44,23 @@ std::string glass_plate_scene(const fs::path& root, const std::string& step) {
     "magic": {"collision_stiffness": 1e13, "repulsion_thickness": 1e-4, "projection_thickness": 1e-5,
               "max_cracks": 400}
   })";
+}
+
+// The plate of glass_plate_scene dropped 3 cm from rest (0.77 m/s at landing) for `duration` s, with `extra`
+// top-level keys (a JSON fragment ending in a comma, or "").
+std::string dropped_plate_scene(const fs::path& root, const std::string& step, const std::string& duration,
+                                const std::string& extra) {
+  std::string scene = glass_plate_scene(root, step);
+  const std::string from = R"("duration": 0.06,)", velocity = R"("velocity": {"linear": [0, 0, -5]},)";
+  scene.replace(scene.find(from), from.size(), R"("duration": )" + duration + ", " + extra);
+  scene.replace(scene.find(velocity), velocity.size(), "");
+  return scene;
+}
+
+Simulation load_scene_text(const TempDir& dir, const std::string& text) {
+  const fs::path path = dir.path / "scene.json";
+  std::ofstream(path) << text;
+  return Simulation(load_scene(path.string()));
 }
 
 TEST(StressGlassSlow, PlateThrownAtAFloorHoldsAtTwoFiveAndTenTimesArcsimsStep) {
@@ -86,16 +105,9 @@ TEST(StressGlassSlow, PlateThrownAtAFloorHoldsAtTwoFiveAndTenTimesArcsimsStep) {
 TEST(StressGlassSlow, ZonesGrowingToACalmSupportKeepAPlateLandingAtFiveMillisecondStepsWhole) {
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
-  const fs::path folder = fs::temp_directory_path() / ("arcsim-glassgrow-" + std::to_string(::getpid()));
-  fs::create_directories(folder);
+  TempDir dir;
   auto cracks_with = [&](const std::string& fracture) {
-    std::string scene = glass_plate_scene(root, "5e-3");
-    const std::string from = R"("duration": 0.06,)", velocity = R"("velocity": {"linear": [0, 0, -5]},)";
-    scene.replace(scene.find(from), from.size(), R"("duration": 0.12, "fracture": )" + fracture + ",");
-    scene.replace(scene.find(velocity), velocity.size(), "");
-    const fs::path path = folder / "glass-grow.json";
-    std::ofstream(path) << scene;
-    Simulation sim(load_scene(path.string()));
+    Simulation sim = load_scene_text(dir, dropped_plate_scene(root, "5e-3", "0.12", R"("fracture": )" + fracture + ","));
     int cracks = 0;
     while (!sim.finished()) {
       sim.advance_frame();
@@ -106,7 +118,6 @@ TEST(StressGlassSlow, ZonesGrowingToACalmSupportKeepAPlateLandingAtFiveMilliseco
   };
   EXPECT_EQ(cracks_with(R"({"max_zone_rings": 16, "support_stress": 0.5})"), 0);
   EXPECT_GT(cracks_with("{}"), 100) << "the default zone no longer shatters the plate: the case proves nothing";
-  fs::remove_all(folder);
 }
 
 // The cause of that shattering, bounded directly: adaptive time stepping with max_correction = the repulsion
@@ -115,18 +126,12 @@ TEST(StressGlassSlow, ZonesGrowingToACalmSupportKeepAPlateLandingAtFiveMilliseco
 TEST(StressGlassSlow, BoundingTheCollisionCorrectionKeepsAPlateLandingAtLargeStepsWhole) {
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
-  const fs::path folder = fs::temp_directory_path() / ("arcsim-glasscorr-" + std::to_string(::getpid()));
-  fs::create_directories(folder);
+  TempDir dir;
   for (const char* step : {"2e-3", "5e-3"}) {
     SCOPED_TRACE(std::string("time step ") + step + " s");
-    std::string scene = glass_plate_scene(root, step);
-    const std::string from = R"("duration": 0.06,)", velocity = R"("velocity": {"linear": [0, 0, -5]},)";
-    scene.replace(scene.find(from), from.size(),
-                  R"("duration": 0.12, "adaptive_time_step": {"max_correction": 1e-4, "min_step": 1e-6},)");
-    scene.replace(scene.find(velocity), velocity.size(), "");
-    const fs::path path = folder / "glass-correction.json";
-    std::ofstream(path) << scene;
-    Simulation sim(load_scene(path.string()));
+    Simulation sim = load_scene_text(
+        dir, dropped_plate_scene(root, step, "0.12",
+                                 R"("adaptive_time_step": {"max_correction": 1e-4, "min_step": 1e-6},)"));
     int cracks = 0, retries = 0, crossing = 0;
     double lowest = 0;
     while (!sim.finished()) {
@@ -142,7 +147,6 @@ TEST(StressGlassSlow, BoundingTheCollisionCorrectionKeepsAPlateLandingAtLargeSte
     EXPECT_GE(lowest, -1e-4);
     EXPECT_EQ(crossing, 0);
   }
-  fs::remove_all(folder);
 }
 
 // The same glass as a 20 cm plate dropped 3 cm onto a floor with a 5 ms step (100x ARCSim's): it shatters on
@@ -153,19 +157,9 @@ TEST(StressGlassSlow, BoundingTheCollisionCorrectionKeepsAPlateLandingAtLargeSte
 TEST(StressGlassSlowCheck, PlateShatteringAtFiveMillisecondStepsEndsWithAdaptiveTimeStepping) {
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
-  const fs::path folder = fs::temp_directory_path() / ("arcsim-glass5ms-" + std::to_string(::getpid()));
-  fs::create_directories(folder);
-  std::string scene = glass_plate_scene(root, "5e-3");
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    const size_t at = scene.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    scene.replace(at, from.size(), to);
-  };
-  replace(R"("duration": 0.06,)", R"("duration": 0.3, "adaptive_time_step": {"min_step": 1e-5},)");
-  replace(R"("velocity": {"linear": [0, 0, -5]},)", "");
-  const fs::path path = folder / "glass-5ms-adaptive.json";
-  std::ofstream(path) << scene;
-  Simulation sim(load_scene(path.string()));
+  TempDir dir;
+  Simulation sim = load_scene_text(
+      dir, dropped_plate_scene(root, "5e-3", "0.3", R"("adaptive_time_step": {"min_step": 1e-5},)"));
   double lowest = 0;
   int crossing = 0, retries = 0, finest = 0;
   std::string invalid, failure;
@@ -190,7 +184,6 @@ TEST(StressGlassSlowCheck, PlateShatteringAtFiveMillisecondStepsEndsWithAdaptive
   int faces = 0;
   for (const Face& f : sim.cloths[0].mesh.faces) faces += !f.dead;
   std::printf("glass plate at 5 ms: %d retries, finest level %d, %d faces at the end\n", retries, finest, faces);
-  fs::remove_all(folder);
 }
 
 }  // namespace
