@@ -1,9 +1,9 @@
 #include "sim/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
-#include <array>
 #include <sstream>
 
 #include "fracture/fracture_sizing.hpp"
@@ -323,8 +323,7 @@ void Simulation::advance_step() {
   } else {
     move_obstacles(time_);
     dynamics_step(dt);
-    ++time_step_stats.substeps;
-    time_step_stats.smallest = time_step_stats.smallest > 0 ? std::min(time_step_stats.smallest, dt) : dt;
+    time_step_stats.record(1, dt, 0);
   }
 
   auto t0 = std::chrono::steady_clock::now();
@@ -417,12 +416,6 @@ void restore_snapshot(const DynamicsSnapshot& s, std::vector<Cloth>& cloths) {
     }
 }
 
-std::string seconds_text(double s) {
-  std::ostringstream out;
-  out << s << " s";
-  return out.str();
-}
-
 }  // namespace
 
 std::string Simulation::substep_problem(double dt) const {
@@ -483,9 +476,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
         nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
       }
       step_fallback_nodes_ = std::move(fallback_nodes);
-      time_step_stats.substeps += substeps;
-      time_step_stats.smallest = time_step_stats.smallest > 0 ? std::min(time_step_stats.smallest, h) : h;
-      time_step_stats.level = std::max(time_step_stats.level, substep_level_);
+      time_step_stats.record(substeps, h, substep_level_);
       if (substep_level_ > 0 && ++steps_at_level_ >= a.grow_after) {
         --substep_level_;
         steps_at_level_ = 0;
@@ -499,7 +490,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
     if (!(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel) {
       std::ostringstream what;
       what << "step " << step_ << " (t = " << start << " to " << start + dt << " s) failed at the smallest substep "
-           << seconds_text(h) << " (adaptive_time_step.min_step " << seconds_text(a.min_step) << "): " << problem
+           << h << " s (adaptive_time_step.min_step " << a.min_step << " s): " << problem
            << "; try a smaller min_step or time step";
       throw NumericalError(what.str());
     }

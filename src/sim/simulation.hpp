@@ -4,6 +4,7 @@
 // fracture substepping, and remeshing at frame ends.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <string>
@@ -135,6 +136,12 @@ class Simulation {
     int substeps = 0, retries = 0, level = 0;
     double smallest = 0;
     std::string cause;
+    // A step taken as `count` substeps of h (s) at `level`.
+    void record(int count, double h, int at_level) {
+      substeps += count;
+      smallest = smallest > 0 ? std::min(smallest, h) : h;
+      level = std::max(level, at_level);
+    }
   };
   TimeStepStats time_step_stats;
   // Adaptive time stepping's state (saved in state files so that a resumed run continues identically): the
