@@ -43,10 +43,11 @@ std::vector<std::vector<ContactTerm>> CollisionHandler::proximity_terms(const st
   params.obstacle_friction = settings.obstacle_friction;
   params.floor = settings.floor;
   params.floor_height = settings.floor_height;
+  params.neighbour_thickness = std::min(settings.repulsion_thickness, settings.neighbour_thickness);
   const std::vector<ProximityContact> contacts = find_proximities(geometry_, cache_, params);
   totals_.proximities += static_cast<long long>(contacts.size());
   for (size_t c = 0; c < cloths.size(); ++c)
-    terms[c] = contact_terms(geometry_, contacts, static_cast<int>(c), settings.repulsion_thickness, dt);
+    terms[c] = contact_terms(geometry_, contacts, static_cast<int>(c), dt);
   return terms;
 }
 

@@ -22,6 +22,9 @@ struct CollisionSettings {
   double obstacle_friction = 0.3;      // cloth-obstacle and floor
   bool floor = false;                  // floor proxy
   double floor_height = 0;             // m
+  // Repulsion thickness between material neighbours (a crack's lips; collision/proximity.hpp), m: the lip
+  // gap new cracks open with.
+  double neighbour_thickness = 0;
   int step = 0;                        // for messages
 };
 

@@ -33,6 +33,7 @@ void append_mesh(const ContactBody& body, ContactStage stage, double dt, Contact
     g.mass.push_back(body.deformable && n.mass > 0 ? n.mass : kInfinity);
     g.area.push_back(0);
     g.node_mesh.push_back(mesh_index);
+    g.rest.push_back(body.deformable && !n.verts.empty() ? mesh.verts[n.verts[0]].u : Vec3::Zero());
   }
   uint64_t topology = mix(mesh.nodes.size(), mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {

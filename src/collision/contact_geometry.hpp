@@ -42,6 +42,9 @@ struct ContactGeometry {
   std::vector<double> mass;          // kg; kInfinity for immovable nodes
   std::vector<double> area;          // m^2, a third of the incident faces' areas
   std::vector<int> node_mesh;
+  // Rest-space (material) position of each deformable node (its first vert's u, m); unused for obstacles.
+  // Proximity uses it to tell a collision from material neighbours (collision/proximity.hpp).
+  std::vector<Vec3> rest;
 
   // Edges and faces by global node indices.
   std::vector<std::array<int, 2>> edges;

@@ -72,12 +72,16 @@ class ProximitySearch {
         break;
     }
     if (!(cp.distance < params_.thickness)) return c;
+    const double thickness =
+        material_neighbours(nodes, cp.weights) ? params_.neighbour_thickness : params_.thickness;
+    if (!(cp.distance < thickness)) return c;
     c.distance = cp.distance;
     c.contact.nodes = nodes;
     c.contact.weights = cp.weights;
     c.contact.normal = cp.normal;
     c.contact.gap = cp.distance;
     c.contact.stiffness = params_.stiffness * std::min(area_a, area_b);
+    c.contact.thickness = thickness;
     bool immovable = false;
     for (int n : nodes)
       if (n != kNone && !g_.movable(n)) immovable = true;
@@ -87,6 +91,27 @@ class ProximitySearch {
 
  private:
   static int side_slot(int element, double side) { return 2 * element + (side >= 0 ? 1 : 0); }
+
+  // True if the pair's closest points are within the repulsion thickness of each other in the rest shape too:
+  // then they are neighbours in the material (a crack's two lips: twins coincide in rest space, and the lips
+  // meet at the tip), not two parts of the sheet that came together. Their penalty starts only at the
+  // neighbour thickness (the gap new lips start with). WHY: with the full thickness and the penalty's
+  // stiffness (ARCSim's glass: 1e13 N/m^3, 1e7 N/m on a 1 mm^2 node), a lip 2e-5 m from its twin was pushed
+  // away with more than the membrane force at the critical stress (0.3-0.5 N against ~0.1 N). That wedged
+  // every crack open at its tip, so it ran on, and each free shard of sphere-break.json held a
+  // self-equilibrated strain of 1% (30 tau) that broke it again until the sphere was dust (4182 pieces by
+  // step 90; 33 with this rule).
+  bool material_neighbours(const std::array<int, 4>& nodes, const std::array<double, 4>& weights) const {
+    const int mesh = g_.node_mesh[nodes[0]];
+    if (!g_.meshes[mesh].deformable) return false;
+    Vec3 rest_gap = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) {
+      if (nodes[k] == kNone) continue;
+      if (g_.node_mesh[nodes[k]] != mesh) return false;
+      rest_gap += weights[k] * g_.rest[nodes[k]];
+    }
+    return rest_gap.norm() < params_.thickness;
+  }
 
   double edge_area(int e) const {
     double a = 0;
@@ -163,6 +188,7 @@ std::vector<ProximityContact> find_proximities(const ContactGeometry& g, BvhCach
         c.normal = Vec3::UnitY();
         c.gap = height;
         c.stiffness = params.stiffness * g.area[n];
+        c.thickness = params.thickness;
         c.friction = params.obstacle_friction;
         contacts.push_back(c);
       }
@@ -172,7 +198,7 @@ std::vector<ProximityContact> find_proximities(const ContactGeometry& g, BvhCach
 }
 
 std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vector<ProximityContact>& contacts,
-                                       int mesh, double thickness, double dt) {
+                                       int mesh, double dt) {
   const auto& r = g.meshes[mesh];
   std::vector<ContactTerm> terms;
   if (!r.deformable) return terms;  // immovable meshes have no implicit system
@@ -181,7 +207,7 @@ std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vect
     for (int n : c.nodes)
       if (n != kNone && n >= r.node_begin && n < r.node_end) involved = true;
     if (!involved) continue;
-    const Penalty p = repulsion_penalty(c.gap, c.stiffness, thickness);
+    const Penalty p = repulsion_penalty(c.gap, c.stiffness, c.thickness);
     if (p.force <= 0 && p.stiffness <= 0) continue;
 
     ContactTerm t;

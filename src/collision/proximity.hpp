@@ -1,5 +1,6 @@
 // Proximity (repulsion) contacts, ARCSim style: at the start of the step every vertex-face and edge-edge pair
-// closer than the repulsion thickness T is a candidate; each node keeps its nearest face on each side of its
+// closer than the repulsion thickness T is a candidate (material neighbours, closer than T in the rest shape
+// too, only within ProximityParams::neighbour_thickness); each node keeps its nearest face on each side of its
 // normal, each edge its nearest edge per side, each face its nearest node per side, and (crack lips) each
 // boundary node / boundary edge its nearest in-plane partner on the outward side of the edge. Each kept pair
 // becomes a one-sided penalty on its gap g = n . sum_i w_i x_i with energy k max(T - g, 0)^3 / (6 T) (J),
@@ -23,6 +24,10 @@ struct ProximityParams {
   double obstacle_friction = 0.3;    // ... when an immovable node takes part (obstacles, floor)
   bool floor = false;                // floor proxy on
   double floor_height = 0;           // m (plane y = floor_height, normal +y)
+  // Thickness (m) between material neighbours: pairs whose closest points are within `thickness` of each other
+  // in the rest shape as well (a crack's two lips). The simulation sets it to the lip gap new cracks open with,
+  // so that lips repel only once they come closer than they started. 0: such pairs never repel.
+  double neighbour_thickness = 0;
 };
 
 struct ProximityContact {
@@ -32,6 +37,7 @@ struct ProximityContact {
   double gap = 0;        // n . sum_i w_i x0_i (m); the floor proxy: height above the plane
   double stiffness = 0;  // k (N/m)
   double friction = 0;   // Coulomb coefficient
+  double thickness = 0;  // T of its penalty (m): ProximityParams::thickness, or neighbour_thickness
 };
 
 // The contacts at the geometry's start positions x0, in a deterministic order.
@@ -47,7 +53,7 @@ Penalty repulsion_penalty(double gap, double k, double thickness);
 // The implicit-step terms of the contacts that involve nodes of mesh `mesh` (local node numbering of that
 // mesh), with the lagged Coulomb friction turned into a tangential damper (see friction_damping).
 std::vector<ContactTerm> contact_terms(const ContactGeometry& g, const std::vector<ProximityContact>& contacts,
-                                       int mesh, double thickness, double dt);
+                                       int mesh, double dt);
 
 // A contact term moved to a gap larger by `gap_change` (m) under the same penalty law (repulsion_penalty: the
 // depth is 2 force / stiffness), the other side at rest (outside_velocity 0). Returns false when the contact

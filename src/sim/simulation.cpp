@@ -233,6 +233,7 @@ CollisionSettings Simulation::collision_settings() const {
   s.stiffness = magic.collision_stiffness * (passive() ? kPassiveStiffnessFactor : 1.0);
   s.friction = scene_.friction;
   s.obstacle_friction = scene_.obs_friction;
+  s.neighbour_thickness = fracture.opening.lip_gap;
   s.step = step_;
   // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
   for (const Obstacle& o : obstacles) {

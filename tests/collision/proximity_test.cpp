@@ -1,10 +1,13 @@
-// Proximity contacts (selection, gaps, stiffness, friction, floor proxy, crack-lip vertex-edge pairs), the
+// Proximity contacts (selection, gaps, stiffness, friction, floor proxy, crack-lip vertex-edge pairs, material
+// neighbours), the
 // penalty's derivatives, friction damping, the conversion into implicit-step terms, and the contact pattern.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "collision/proximity.hpp"
+#include "mesh/edits.hpp"
+#include "mesh/validate.hpp"
 #include "support/mesh_factory.hpp"
 
 namespace arcsim {
@@ -193,7 +196,7 @@ TEST(Proximity, ContactTermsSplitPerCloth) {
   s.build();
   BvhCache cache;
   const auto contacts = find_proximities(s.g, cache, params());
-  const auto terms = contact_terms(s.g, contacts, 0, kT, 1e-3);
+  const auto terms = contact_terms(s.g, contacts, 0, 1e-3);
   ASSERT_FALSE(terms.empty());
   for (const ContactTerm& t : terms) {
     EXPECT_GT(t.force, 0);
@@ -210,7 +213,7 @@ TEST(Proximity, ContactTermsSplitPerCloth) {
     }
   }
   // Nothing for the plate (immovable, no cloth of its own).
-  EXPECT_TRUE(contact_terms(s.g, contacts, 1, kT, 1e-3).empty());
+  EXPECT_TRUE(contact_terms(s.g, contacts, 1, 1e-3).empty());
 }
 
 TEST(Proximity, ContactPatternRebuiltOnlyForNewPairs) {
@@ -237,6 +240,97 @@ TEST(Proximity, ContactPatternRebuiltOnlyForNewPairs) {
   EXPECT_FALSE(update_contact_pattern(cache, {far}));
   EXPECT_FALSE(update_contact_pattern(cache, {}));
   EXPECT_EQ(cache.pattern.id(), with_far);
+}
+
+}  // namespace
+}  // namespace arcsim
+
+namespace arcsim {
+namespace {
+
+// A 0.4 x 0.2 m sheet (4 x 2 cells) cut in two along its middle row of edges, y = 0.1 (a crack run from border
+// to border): the two halves' facing lips coincide in the rest shape. The upper half is then moved up by
+// `gap` (m) in the world, so the lips are `gap` apart.
+Mesh cracked_sheet(double gap) {
+  Mesh m = testing::make_grid(4, 2, 0.4, 0.2);
+  auto id = [](int i, int j) { return j * 5 + i; };
+  for (int i = 0; i < 4; ++i) {
+    const EditResult r = split_node(m, id(i, 1), {m.find_edge(id(i, 1), id(i + 1, 1))});
+    EXPECT_TRUE(r.ok) << "split at node " << id(i, 1);
+  }
+  EXPECT_EQ(count_components(m), 2);
+  for (Node& n : m.nodes) n.mass = 1e-3;
+  // The upper half: nodes whose faces all lie above the cut.
+  for (size_t k = 0; k < m.nodes.size(); ++k) {
+    bool upper = true;
+    for (int f : m.node_faces(static_cast<int>(k)))
+      for (int i = 0; i < 3; ++i) upper = upper && m.verts[m.faces[f].v[i]].u.y() > 0.1 - 1e-12;
+    if (upper) m.nodes[k].x.y() += gap;
+  }
+  for (Node& n : m.nodes) n.x0 = n.x;
+  return m;
+}
+
+int contacts_across(const std::vector<ProximityContact>& contacts, double* thickness = nullptr) {
+  int count = 0;
+  for (const auto& c : contacts) {
+    if (std::abs(c.normal.y()) < 0.99) continue;  // across the cut: in the sheet's plane, along y
+    ++count;
+    if (thickness) *thickness = c.thickness;
+  }
+  return count;
+}
+
+TEST(Proximity, CrackLipsAreMaterialNeighboursThatRepelOnlyWithinTheNeighbourThickness) {
+  // Lips 0.5 T apart, twins coincident in the rest shape: with the full thickness between them they would be
+  // pushed apart at once (a wedge at every crack tip); they repel only within the neighbour thickness.
+  const Mesh m = cracked_sheet(0.5 * kT);
+  ContactGeometry g;
+  build_contact_geometry({{&m, true}}, ContactStage::kBeforeStep, 1e-3, g);
+  BvhCache cache;
+  ProximityParams p = params();
+  EXPECT_EQ(contacts_across(find_proximities(g, cache, p)), 0);  // neighbour thickness 0: never
+  p.neighbour_thickness = 0.25 * kT;                                // still closer than the lips are
+  EXPECT_EQ(contacts_across(find_proximities(g, cache, p)), 0);
+  p.neighbour_thickness = 0.75 * kT;                                // the lips came closer than that
+  double thickness = 0;
+  const auto contacts = find_proximities(g, cache, p);
+  EXPECT_GE(contacts_across(contacts, &thickness), 3);
+  EXPECT_DOUBLE_EQ(thickness, 0.75 * kT);
+  // Their terms follow the contact's own thickness: the cubic penalty's force / stiffness is half the depth,
+  // 0.5 (0.75 T - 0.5 T) (with the full thickness it would be 0.25 T).
+  int terms = 0;
+  for (const ContactTerm& t : contact_terms(g, contacts, 0, 1e-3)) {
+    if (std::abs(t.normal.y()) < 0.99) continue;
+    ++terms;
+    EXPECT_NEAR(t.force / t.stiffness, 0.125 * kT, 1e-12);
+  }
+  EXPECT_GE(terms, 3);
+}
+
+TEST(Proximity, PartsOfOneSheetFarApartInTheRestShapeRepelAtTheFullThickness) {
+  // The same sheet, its upper half laid back over its lower half 0.5 T above it (a fold): those points are
+  // 0.1 m apart in the rest shape, so they are a collision, whatever the neighbour thickness.
+  Mesh m = cracked_sheet(0);
+  for (size_t k = 0; k < m.nodes.size(); ++k) {
+    bool upper = true;
+    for (int f : m.node_faces(static_cast<int>(k)))
+      for (int i = 0; i < 3; ++i) upper = upper && m.verts[m.faces[f].v[i]].u.y() > 0.1 - 1e-12;
+    Node& n = m.nodes[k];
+    if (upper) n.x = Vec3(n.x.x(), 0.2 - n.x.y(), 0.5 * kT);
+  }
+  for (Node& n : m.nodes) n.x0 = n.x;
+  ContactGeometry g;
+  build_contact_geometry({{&m, true}}, ContactStage::kBeforeStep, 1e-3, g);
+  BvhCache cache;
+  int stacked = 0;
+  for (const auto& c : find_proximities(g, cache, params())) {
+    if (std::abs(c.normal.z()) < 0.99) continue;
+    ++stacked;
+    EXPECT_DOUBLE_EQ(c.thickness, kT);
+    EXPECT_NEAR(c.gap, 0.5 * kT, 1e-7);
+  }
+  EXPECT_GE(stacked, 6);
 }
 
 }  // namespace

@@ -49,6 +49,7 @@ struct StripSpec {
   // Clamp columns: nodes with rest x within this of either end are held by stiff handles.
   double clamp = 1e-9;
   std::function<void(Mesh&)> prepare;  // edits of the mesh before it is written (a slit)
+  double repulsion_thickness = -1, projection_thickness = -1;  // m; < 0: the scene defaults
 };
 
 Material tough_sheet(double youngs, double toughness, double thickness) {
@@ -97,6 +98,8 @@ void build(StripSim& run, const StripSpec& s) {
   scene.disabled = {"plasticity", "strainlimiting", "separation", "popfilter"};
   if (!(s.size_min > 0)) scene.disabled.insert("remeshing");
   scene.magic.handle_stiffness = 1e9;
+  if (s.repulsion_thickness > 0) scene.magic.repulsion_thickness = s.repulsion_thickness;
+  if (s.projection_thickness > 0) scene.magic.projection_thickness = s.projection_thickness;
   scene.cloths.push_back(cloth_spec(run.dir.path / "strip.obj", make_transform(Vec3::Zero()), s.material));
   RemeshingParams& r = scene.cloths[0].remeshing;
   r.refine_angle = 0.3;
@@ -302,6 +305,12 @@ TEST(FractureSubstepOpenings, StrictAndIndependentBothGiveValidMeshes) {
                                     std::to_string(independent_pieces) + " pieces");
 }
 
+// Collision thicknesses of ARCSim's fracture scenes (paper-tearing.json): repulsion 1e-4 m, projection 1e-5 m, so
+// that new lips start 2e-5 m apart, 1% of size_min. WHY not the defaults (1e-3, 1e-4): the 0.2 mm lip gap they
+// give is 10% of a 2 mm face, taken up by the lip faces' plastic stretch (stress-free), and remeshing averages
+// those stretches into strains the elastic sheet cannot relax; the path then wanders by 3.2 to 5.9 mm.
+constexpr double kModeIProjectionThickness = 1e-5;
+
 TEST(FractureModeI, NotchedStripTearsStraightAcross) {
   // Pulled along y across a slit along x at y = width / 2 from the left border to x = slit.
   StripSpec s;
@@ -312,6 +321,8 @@ TEST(FractureModeI, NotchedStripTearsStraightAcross) {
   s.size_max = 0.004;
   s.material = tough_sheet(1e9, 1e7, 1e-3);
   const double slit = 0.012;
+  s.repulsion_thickness = 10 * kModeIProjectionThickness;
+  s.projection_thickness = kModeIProjectionThickness;
   s.prepare = [&](Mesh& mesh) {
     // Node splits along the grid line y = width / 2 from the border inwards (what a crack would do).
     for (double x = 0; x < slit - 1e-9; x += s.cell) {
@@ -326,25 +337,30 @@ TEST(FractureModeI, NotchedStripTearsStraightAcross) {
       ASSERT_NE(to, kNone);
       const EditResult r = split_node(mesh, from, {mesh.find_edge(from, to)});
       ASSERT_TRUE(r.ok);
-      // The lips 2 um apart (as crack openings leave them): coincident lips have no contact normal.
+      // The lips apart by the gap crack openings leave (twice the projection thickness), in the rest shape
+      // too, so that the slit is cut, not strained open: coincident lips have no contact normal, and closer
+      // lips would be wedged apart by their repulsion.
+      const double half_gap = kModeIProjectionThickness;
       for (int n : {from, r.added_nodes[0]}) {
         Vec3 centroid = Vec3::Zero();
         const std::vector<int> faces = mesh.node_faces(n);
         for (int f : faces)
           for (int i = 0; i < 3; ++i) centroid += mesh.nodes[mesh.face_node(f, i)].x / (3.0 * faces.size());
-        mesh.nodes[n].x.y() += centroid.y() > mesh.nodes[n].x.y() ? 1e-6 : -1e-6;
+        const double shift = centroid.y() > mesh.nodes[n].x.y() ? half_gap : -half_gap;
+        mesh.nodes[n].x.y() += shift;
         mesh.nodes[n].x0 = mesh.nodes[n].x;
+        for (int v : mesh.nodes[n].verts) mesh.verts[v].u.y() += shift;
       }
     }
+    mesh.update_rest_data();
     mesh.compact();
   };
-  // Several loading rates: one rate alone gives one sample of a path that wanders by an element or two at the
-  // slit's tip, where the fracture sizing refines the 4 mm cells to size_min. Before the clamps kept the nodes
-  // that remeshing adds between their nodes within a step (Handle::holds_line, sim/remesh_cloth.hpp), those
-  // nodes were loose until the next step, and the worst deviation at these four rates was 4.6, 3.5, 5.8 and
-  // 8.1 mm; with them held, 3.3 to 4.6 mm. The fracture issue's acceptance asks for under 2 size_min (4 mm):
-  // not met at three of the four rates (a short side loop within 4 mm of the slit's tip); the bound here is
-  // the regression guard, 2.5 size_min.
+  // Several loading rates: one rate alone gives one sample of a path. History of the worst deviation at these
+  // four rates: 4.6 to 8.1 mm while nodes that remeshing added between clamp nodes were loose for a step; 3.3
+  // to 4.6 mm with them held (Handle::holds_line), with the default thicknesses and lips that repelled each
+  // other across the full repulsion thickness (a wedge at the tip); with lips that repel only within the lip
+  // gap (collision/proximity.hpp), 3.2 to 5.9 mm with the default thicknesses and 0.01 mm (the lip gap
+  // itself: straight along the grid line) with ARCSim's fracture thicknesses. The acceptance: under 2 size_min.
   for (const double rate : {1.9e-6, 2.0e-6, 2.1e-6, 2.2e-6}) {  // m per side per step
     SCOPED_TRACE("opening " + std::to_string(rate * 1e6) + " um per step");
     StripSim run;
@@ -370,7 +386,7 @@ TEST(FractureModeI, NotchedStripTearsStraightAcross) {
       worst = std::max(worst, std::abs(rest_midpoint(mesh, e).y() - s.width / 2));
     std::printf("mode I, opening %.2g m per step: %d cracks, largest deviation %.3g mm (size_min %.3g mm)\n", rate,
                 cracks, 1e3 * worst, 1e3 * s.size_min);
-    EXPECT_LT(worst, 2.5 * s.size_min);
+    EXPECT_LT(worst, 2 * s.size_min);
   }
 }
 
