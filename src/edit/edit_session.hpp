@@ -111,14 +111,14 @@ struct NodeMoveOptions {
   // surface than the clearance (a lip set apart next to the lip of an earlier crack; collision handling keeps
   // the two apart from then on).
   bool require_clearance = true;
-  // True: the move strains nothing. Each face of the node takes the move into its plastic stretch Fp so that its
-  // elastic deformation F Fp stays what it was (mass and rest shape untouched). WHY: a crack's lips are set
-  // apart by a gap the collision stage needs (twice the projection thickness, 2e-5 m in ARCSim's scenes), and
-  // over glass's 1 mm faces that gap is a 1% strain, 25 times glass's critical strain: every opening of
+  // True: the move strains nothing. The node's rest position moves with it on its elastic faces (the rest-space
+  // image of the move: a cut of the rest shape, not a strain), and each of those faces keeps its mass
+  // (thickness times rest area; the thickness changes by the gap over the face's size). WHY: a crack's lips are
+  // set apart by a gap the collision stage needs (twice the projection thickness, 2e-5 m in ARCSim's scenes),
+  // and over glass's 1 mm faces that gap is a 1% strain, 25 times glass's critical strain: every opening of
   // sphere-break.json added elastic energy (72 J in one step) and its stress cracked the lips' neighbours.
-  // Faces of plastic materials keep their Fp: the flow rules and the plastic embedding own it there (a rebuild
-  // from the embedding rescales the thickness with det Fp, which changed the mass), and a ductile sheet yields
-  // to a strain of that size anyway.
+  // Faces of plastic materials are left as they are: a ductile sheet yields to a strain of that size anyway,
+  // and their rest shape belongs to the plastic embedding.
   bool stress_free = false;
 };
 
@@ -179,6 +179,7 @@ class EditSession {
   std::vector<double> plastic_offsets(const std::vector<int>& edges) const;
   void apply_rest_angles(const std::vector<int>& edges, const std::vector<double>& offsets);
   void refresh_rest_angles(const std::vector<int>& faces);
+  void cut_rest_shape(int node, const std::vector<std::pair<int, Vec3>>& rest_moves);
   // kReprojection: `node` even if preserved (split_node marks every node it splits preserved).
   bool reproject_unchecked(int node);
   // kGuardMoves
