@@ -100,6 +100,18 @@ void build_contact_geometry(const std::vector<ContactBody>& bodies, ContactStage
   g.owned_edge_begin.push_back(static_cast<int>(g.owned_edges.size()));
 }
 
+double rest_distance(const ContactGeometry& g, const std::array<int, 4>& nodes, const std::array<double, 4>& weights) {
+  const int mesh = g.node_mesh[nodes[0]];
+  if (!g.meshes[mesh].deformable) return kInfinity;
+  Vec3 gap = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) {
+    if (nodes[k] == kNone) continue;
+    if (g.node_mesh[nodes[k]] != mesh) return kInfinity;
+    gap += weights[k] * g.rest[nodes[k]];
+  }
+  return gap.norm();
+}
+
 std::vector<Vec3> face_normals(const ContactGeometry& g, const std::vector<Vec3>& x) {
   std::vector<Vec3> n(g.faces.size(), Vec3::Zero());
   for (size_t f = 0; f < g.faces.size(); ++f) {

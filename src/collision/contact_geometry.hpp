@@ -68,6 +68,12 @@ struct ContactGeometry {
 void build_contact_geometry(const std::vector<ContactBody>& bodies, ContactStage stage, double dt,
                             ContactGeometry& geometry);
 
+// The distance (m) in the rest shape between the two points of a pair (weights as in collision/distance.hpp:
+// positive on one side, negative on the other, each side summing to 1), if all its nodes belong to one
+// deformable mesh; infinity otherwise. Small for material neighbours, such as a crack's two lips, which are
+// not a collision that needs a repulsion (collision/proximity.hpp).
+double rest_distance(const ContactGeometry& g, const std::array<int, 4>& nodes, const std::array<double, 4>& weights);
+
 // Unit normals of faces, and of nodes and edges (normalised sums of the incident face normals) at positions x.
 std::vector<Vec3> face_normals(const ContactGeometry& g, const std::vector<Vec3>& x);
 std::vector<Vec3> node_normals(const ContactGeometry& g, const std::vector<Vec3>& face_normal);

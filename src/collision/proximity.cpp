@@ -102,15 +102,7 @@ class ProximitySearch {
   // self-equilibrated strain of 1% (30 tau) that broke it again until the sphere was dust (4182 pieces by
   // step 90; 33 with this rule).
   bool material_neighbours(const std::array<int, 4>& nodes, const std::array<double, 4>& weights) const {
-    const int mesh = g_.node_mesh[nodes[0]];
-    if (!g_.meshes[mesh].deformable) return false;
-    Vec3 rest_gap = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) {
-      if (nodes[k] == kNone) continue;
-      if (g_.node_mesh[nodes[k]] != mesh) return false;
-      rest_gap += weights[k] * g_.rest[nodes[k]];
-    }
-    return rest_gap.norm() < params_.thickness;
+    return rest_distance(g_, nodes, weights) < params_.thickness;
   }
 
   double edge_area(int e) const {
