@@ -53,7 +53,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (bytes.size() >= kSizeOffset + 8 + kChecksumBytes) {
     put_u64(bytes, kSizeOffset, bytes.size());
     const size_t body = bytes.size() - kChecksumBytes;
-    put_u64(bytes, body, arcsim::fnv1a64(reinterpret_cast<const char*>(bytes.data()), body));
+    // The checksum of the version the (possibly mutated) header names; unknown versions are refused before it.
+    uint32_t version = 0;
+    for (int k = 0; k < 4; ++k) version |= static_cast<uint32_t>(bytes[8 + k]) << (8 * k);
+    put_u64(bytes, body, arcsim::state_checksum(reinterpret_cast<const char*>(bytes.data()), body, version));
   }
   const std::string path = arcsim::fuzz::write_input("input.state", bytes.data(), bytes.size());
   try {

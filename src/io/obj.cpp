@@ -1,6 +1,5 @@
 #include "io/obj.hpp"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -16,6 +15,7 @@
 #include <system_error>
 #include <unordered_set>
 
+#include "io/atomic_file.hpp"
 #include "math/errors.hpp"
 #include "mesh/validate.hpp"
 
@@ -547,6 +547,12 @@ void append_number(std::string& out, double x) {
   out.append(buffer, result.ptr);
 }
 
+void append_int(std::string& out, long long n) {
+  char buffer[24];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, n);
+  out.append(buffer, result.ptr);
+}
+
 void append_line(std::string& out, const char* tag, std::initializer_list<double> values) {
   out += tag;
   for (double x : values) {
@@ -560,22 +566,6 @@ void append_vec3(std::string& out, const char* tag, const Vec3& x) { append_line
 
 void append_mat3(std::string& out, const char* tag, const Mat3& m) {
   append_line(out, tag, {m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2)});
-}
-
-// Writes to "<path>.tmp.<pid>" and renames, so a reader never sees a partial file.
-void write_file_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  auto fail = [&](int error) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot write (" + std::generic_category().message(error) + ")");
-  };
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) throw InputError(path + ": cannot write (" + std::generic_category().message(errno) + ")");
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-  const int write_error = errno;
-  if (std::fclose(file) != 0) fail(errno);
-  if (!written) fail(write_error);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
 }
 
 // 1-based file numbers of the live elements (dead ones are skipped and get kNone).
@@ -640,7 +630,11 @@ void write_obj(const Mesh& mesh, const std::string& path) {
     if (n.dead) continue;
     append_vec3(out, "v", n.x);
     if (n.v != Vec3::Zero()) append_vec3(out, "nv", n.v);
-    if (n.label != 0) out += "nl " + std::to_string(n.label) + "\n";
+    if (n.label != 0) {
+      out += "nl ";
+      append_int(out, n.label);
+      out += '\n';
+    }
   }
   for (const Vert& v : mesh.verts) {
     if (v.dead) continue;
@@ -650,10 +644,18 @@ void write_obj(const Mesh& mesh, const std::string& path) {
   for (const Face& f : mesh.faces) {
     if (f.dead) continue;
     out += "f";
-    for (int i = 0; i < 3; ++i)
-      out += " " + std::to_string(node_number[mesh.verts[f.v[i]].node]) + "/" + std::to_string(vert_number[f.v[i]]);
-    out += "\n";
-    if (f.material != 0) out += "tm " + std::to_string(f.material) + "\n";
+    for (int i = 0; i < 3; ++i) {
+      out += ' ';
+      append_int(out, node_number[mesh.verts[f.v[i]].node]);
+      out += '/';
+      append_int(out, vert_number[f.v[i]]);
+    }
+    out += '\n';
+    if (f.material != 0) {
+      out += "tm ";
+      append_int(out, f.material);
+      out += '\n';
+    }
     if (f.thickness != 0) append_line(out, "th", {f.thickness});
     if (f.Sp != Mat3::Zero()) append_mat3(out, "tp", f.Sp);
     if (f.Fp != Mat3::Identity()) append_mat3(out, "ts", f.Fp);
@@ -666,12 +668,17 @@ void write_obj(const Mesh& mesh, const std::string& path) {
     // Bitwise comparison on purpose: any difference from what the reader recomputes must be recorded.
     const bool custom_angle = !(edge.rest_theta == default_angle[e]);
     if (!custom_angle && !edge.preserve && edge.damage == 0) continue;
-    out += "e " + std::to_string(node_number[edge.n[0]]) + " " + std::to_string(node_number[edge.n[1]]) + "\n";
+    out += "e ";
+    append_int(out, node_number[edge.n[0]]);
+    out += ' ';
+    append_int(out, node_number[edge.n[1]]);
+    out += '\n';
     if (custom_angle) append_line(out, "ea", {edge.rest_theta});
     if (edge.damage != 0) append_line(out, "ed", {edge.damage});
     if (edge.preserve) out += "ep\n";
   }
-  write_file_atomically(path, out);
+  // Frames are outputs, not resume points (states are): renamed whole, but not flushed to the disk one by one.
+  write_file_atomically(path, out, Durability::kProcessCrash);
 }
 
 void write_plain_obj(const Mesh& mesh, const std::string& path) {
@@ -684,10 +691,13 @@ void write_plain_obj(const Mesh& mesh, const std::string& path) {
   for (const Face& f : mesh.faces) {
     if (f.dead) continue;
     out += "f";
-    for (int i = 0; i < 3; ++i) out += " " + std::to_string(node_number[mesh.verts[f.v[i]].node]);
-    out += "\n";
+    for (int i = 0; i < 3; ++i) {
+      out += ' ';
+      append_int(out, node_number[mesh.verts[f.v[i]].node]);
+    }
+    out += '\n';
   }
-  write_file_atomically(path, out);
+  write_file_atomically(path, out, Durability::kProcessCrash);
 }
 
 }  // namespace arcsim

@@ -1,8 +1,5 @@
 #include "io/state.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <climits>
@@ -14,6 +11,7 @@
 #include <system_error>
 #include <utility>
 
+#include "io/atomic_file.hpp"
 #include "math/errors.hpp"
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
@@ -35,10 +33,6 @@ void append_le(std::string& out, uint64_t value) {
 }
 
 }  // namespace
-
-void StateWriter::put_u32(uint32_t value) { append_le<4>(bytes_, value); }
-
-void StateWriter::put_u64(uint64_t value) { append_le<8>(bytes_, value); }
 
 void StateWriter::put_f64(double value) {
   static_assert(sizeof(double) == sizeof(uint64_t), "IEEE-754 binary64 expected");
@@ -115,6 +109,28 @@ uint64_t fnv1a64(const char* data, size_t size) {
     hash *= 1099511628211ull;  // FNV prime
   }
   return hash;
+}
+
+uint64_t state_checksum(const char* data, size_t size, uint32_t version) {
+  if (version < 2) return fnv1a64(data, size);
+  constexpr uint64_t kPrime = 1099511628211ull;
+  uint64_t hash = 14695981039346656037ull;
+  const unsigned char* bytes = reinterpret_cast<const unsigned char*>(data);
+  size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    uint64_t word;  // one load (a byte-by-byte assembly was not merged by the compiler)
+    std::memcpy(&word, bytes + i, sizeof word);
+#if __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+    word = __builtin_bswap64(word);
+#endif
+    hash = (hash ^ word) * kPrime;
+  }
+  if (i < size) {
+    uint64_t word = 0;
+    for (int k = 0; i + k < size; ++k) word |= static_cast<uint64_t>(bytes[i + k]) << (8 * k);
+    hash = (hash ^ word) * kPrime;
+  }
+  return (hash ^ static_cast<uint64_t>(size)) * kPrime;
 }
 
 namespace {
@@ -569,7 +585,7 @@ std::string encode_state(const Simulation& sim) {
     append_u64(out, payloads[i].size());
   }
   for (const std::string& p : payloads) out += p;
-  append_u64(out, fnv1a64(out.data(), out.size()));
+  append_u64(out, state_checksum(out.data(), out.size()));
   return out;
 }
 
@@ -587,16 +603,16 @@ std::vector<SectionSpan> parse_envelope(const std::string& bytes, const std::str
   if (std::memcmp(bytes.data(), kMagic, std::min(size, sizeof kMagic)) != 0) fail("not an arcsim state file");
   if (size < sizeof kMagic + 4) fail(truncated);
   const uint32_t version = decode_u32(bytes.data() + 8);
-  if (version != kStateFormatVersion)
-    fail("state file version " + std::to_string(version) + ", this arcsim reads version " +
-         std::to_string(kStateFormatVersion));
+  if (version < kOldestStateFormatVersion || version > kStateFormatVersion)
+    fail("state file version " + std::to_string(version) + ", this arcsim reads versions " +
+         std::to_string(kOldestStateFormatVersion) + " to " + std::to_string(kStateFormatVersion));
   if (size < kHeaderBytes + kChecksumBytes) fail(truncated);
   const uint64_t declared = decode_u64(bytes.data() + 16);
   if (size < declared)
     fail("truncated state file (" + std::to_string(size) + " bytes, the header says " + std::to_string(declared) +
          ")");
   const uint64_t stored = decode_u64(bytes.data() + size - kChecksumBytes);
-  if (stored != fnv1a64(bytes.data(), size - kChecksumBytes)) fail("checksum mismatch: the state file is corrupt");
+  if (stored != state_checksum(bytes.data(), size - kChecksumBytes, version)) fail("checksum mismatch: the state file is corrupt");
   if (size != declared)
     fail("file size " + std::to_string(size) + " differs from the " + std::to_string(declared) +
          " bytes in its header");
@@ -641,42 +657,13 @@ std::string read_file(const std::string& path) {
   return bytes;
 }
 
-// Writes "<path>.tmp.<pid>", flushes it to disk and renames it over `path`: a crash leaves either the old
-// file or the complete new one, never a partial state to resume from.
-void write_file_atomically(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  auto fail = [&](int error) {
-    if (fd >= 0) std::remove(tmp.c_str());
-    throw InputError(path + ": cannot write (" + std::generic_category().message(error) + ")");
-  };
-  if (fd < 0) fail(errno);
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int error = errno;
-      ::close(fd);
-      fail(error);
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int error = errno;
-    ::close(fd);
-    fail(error);
-  }
-  if (::close(fd) != 0) fail(errno);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
-}
-
 }  // namespace
 
 void save_state(const Simulation& sim, const std::string& path) {
   const std::string problem = sim.nonfinite_state();
   if (!problem.empty()) throw NumericalError(path + ": not written: " + problem);
-  write_file_atomically(path, encode_state(sim));
+  // The state is the point a run resumes from: it must survive a crash of the machine, not only of the process.
+  write_file_atomically(path, encode_state(sim), Durability::kPowerLoss);
 }
 
 void load_state(Simulation& sim, const std::string& path) {

@@ -23,7 +23,9 @@
 // as new tagged sections in state.cpp; a reader that meets a tag it does not know refuses the file, naming it.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -33,7 +35,10 @@ namespace arcsim {
 
 class Simulation;
 
-constexpr uint32_t kStateFormatVersion = 1;
+// Version 2 (2026-12-03) checksums 64-bit words instead of bytes (8x fewer multiplies: the byte loop was a third
+// of the time spent saving a state); version 1 files are still read.
+constexpr uint32_t kStateFormatVersion = 2;
+constexpr uint32_t kOldestStateFormatVersion = 1;
 
 // Writes the state to `path` atomically (a temporary file renamed over it). Throws InputError "<path>: cannot
 // write (...)" if the file cannot be written, NumericalError "<path>: not written: ..." (nothing written) if the
@@ -52,10 +57,10 @@ void load_state(Simulation& sim, const std::string& path);
 
 class StateWriter {
  public:
-  void put_u8(uint8_t value) { bytes_.push_back(static_cast<char>(value)); }
+  void put_u8(uint8_t value) { *grow(1) = static_cast<char>(value); }
   void put_bool(bool value) { put_u8(value ? 1 : 0); }
-  void put_u32(uint32_t value);
-  void put_u64(uint64_t value);
+  void put_u32(uint32_t value) { put_le<4>(value); }
+  void put_u64(uint64_t value) { put_le<8>(value); }
   void put_i32(int32_t value) { put_u32(static_cast<uint32_t>(value)); }
   void put_i64(int64_t value) { put_u64(static_cast<uint64_t>(value)); }
   void put_f64(double value);  // the raw bits: -0, denormals and infinities survive
@@ -68,14 +73,48 @@ class StateWriter {
   // A count (uint32) then the values; throws std::length_error past 2^32 - 1 entries.
   void put_count(size_t count);
   void put_int_list(const std::vector<int>& values);
-  void put_bytes(const char* data, size_t size) { bytes_.append(data, size); }
+  void put_bytes(const char* data, size_t size) {
+    if (size > 0) std::memcpy(grow(size), data, size);
+  }
   // Makes room for `extra` more bytes, sparing the regrowth of a large payload.
-  void reserve(size_t extra) { bytes_.reserve(bytes_.size() + extra); }
-  const std::string& bytes() const { return bytes_; }
-  std::string take() { return std::move(bytes_); }
+  void reserve(size_t extra) {
+    if (used_ + extra > bytes_.size()) bytes_.resize(used_ + extra);
+  }
+  size_t size() const { return used_; }
+  std::string take() {
+    bytes_.resize(used_);
+    used_ = 0;
+    return std::move(bytes_);
+  }
 
  private:
-  std::string bytes_;
+  // The next n bytes of the payload, to be written (the buffer grows geometrically; appending to a
+  // std::string value by value dominated saving large meshes).
+  char* grow(size_t n) {
+    if (used_ + n > bytes_.size()) bytes_.resize(std::max(2 * bytes_.size(), used_ + n));
+    char* at = &bytes_[used_];
+    used_ += n;
+    return at;
+  }
+  // Little-endian bytes of the low N bytes of `value` (one store on little-endian hosts).
+  template <int N>
+  void put_le(uint64_t value) {
+    static_assert(N == 4 || N == 8, "4- or 8-byte fields");
+    char* at = grow(N);
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    if constexpr (N == 8) {
+      std::memcpy(at, &value, 8);
+    } else {
+      const uint32_t low = static_cast<uint32_t>(value);
+      std::memcpy(at, &low, N);
+    }
+#else
+    for (int i = 0; i < N; ++i) at[i] = static_cast<char>(static_cast<uint8_t>(value >> (8 * i)));
+#endif
+  }
+
+  std::string bytes_;  // [0, used_) written; the rest is room
+  size_t used_ = 0;
 };
 
 // Reads a section's payload. Every read is bounds-checked: running past the end throws InputError
@@ -117,7 +156,12 @@ class StateReader {
   std::string context_;
 };
 
-// FNV-1a 64-bit hash of `size` bytes (the state file checksum).
+// FNV-1a 64-bit hash of `size` bytes (the checksum of version 1 state files).
 uint64_t fnv1a64(const char* data, size_t size);
+
+// The checksum of a state file of `version` over its `size` bytes before the checksum. Version 2 and later: FNV-1a
+// steps over the bytes taken as little-endian 64-bit words (a last partial word zero-padded), then over the byte
+// count, so that trailing zero bytes still change it. Version 1: fnv1a64.
+uint64_t state_checksum(const char* data, size_t size, uint32_t version = kStateFormatVersion);
 
 }  // namespace arcsim

@@ -95,7 +95,7 @@ std::vector<Section> split_sections(const std::string& bytes) {
   return sections;
 }
 
-std::string assemble(const std::vector<Section>& sections, uint32_t version = 1) {
+std::string assemble(const std::vector<Section>& sections, uint32_t version = kStateFormatVersion) {
   std::string out = "ARCSIMST";
   put_le(out, version, 4);
   put_le(out, sections.size(), 4);
@@ -107,7 +107,7 @@ std::string assemble(const std::vector<Section>& sections, uint32_t version = 1)
     put_le(out, s.payload.size(), 8);
   }
   for (const Section& s : sections) out += s.payload;
-  put_le(out, fnv1a64(out.data(), out.size()), 8);
+  put_le(out, state_checksum(out.data(), out.size(), version), 8);
   return out;
 }
 
@@ -177,15 +177,59 @@ TEST_F(StateErrors, NotAStateFile) {
 
 TEST_F(StateErrors, OtherFormatVersion) {
   Simulation sim(scene_);
-  // A well-formed file of version 2 (checksum valid), and one whose version bytes alone were changed.
-  write_bytes(path("v2.state"), assemble(split_sections(bytes_), 2));
-  EXPECT_EQ(load_error(sim, path("v2.state")), path("v2.state") + ": state file version 2, this arcsim reads version 1");
+  // A well-formed file of the next version (checksum valid), and one whose version bytes alone were changed.
+  const std::string next = std::to_string(kStateFormatVersion + 1);
+  write_bytes(path("next.state"), assemble(split_sections(bytes_), kStateFormatVersion + 1));
+  EXPECT_EQ(load_error(sim, path("next.state")),
+            path("next.state") + ": state file version " + next + ", this arcsim reads versions 1 to 2");
   std::string bytes = bytes_;
-  bytes[10] = 1;  // version 65537
-  write_bytes(path("v65537.state"), bytes);
-  EXPECT_EQ(load_error(sim, path("v65537.state")),
-            path("v65537.state") + ": state file version 65537, this arcsim reads version 1");
+  bytes[10] = 1;  // version 65536 + 2
+  write_bytes(path("v65538.state"), bytes);
+  EXPECT_EQ(load_error(sim, path("v65538.state")),
+            path("v65538.state") + ": state file version 65538, this arcsim reads versions 1 to 2");
+  write_bytes(path("v0.state"), assemble(split_sections(bytes_), 0));
+  EXPECT_EQ(load_error(sim, path("v0.state")),
+            path("v0.state") + ": state file version 0, this arcsim reads versions 1 to 2");
   expect_untouched(sim, scene_);
+}
+
+// Version 1 files (byte-wise FNV-1a checksum) still load, to the same simulation as the version 2 file; a version 1
+// file with a version 2 checksum, or the other way round, is refused as corrupt.
+TEST_F(StateErrors, VersionOneFilesStillLoadAndEachVersionChecksItsOwnChecksum) {
+  const std::vector<Section> sections = split_sections(bytes_);
+  write_bytes(path("v1.state"), assemble(sections, 1));
+  Simulation from_v1(scene_), from_v2(scene_);
+  EXPECT_EQ(load_error(from_v1, path("v1.state")), "");
+  write_bytes(path("v2.state"), assemble(sections, 2));
+  EXPECT_EQ(load_error(from_v2, path("v2.state")), "");
+  ASSERT_EQ(from_v1.cloths[0].mesh.nodes.size(), from_v2.cloths[0].mesh.nodes.size());
+  for (size_t n = 0; n < from_v1.cloths[0].mesh.nodes.size(); ++n)
+    EXPECT_EQ(from_v1.cloths[0].mesh.nodes[n].x, from_v2.cloths[0].mesh.nodes[n].x);
+
+  std::string swapped = assemble(sections, 1);
+  swapped.resize(swapped.size() - 8);
+  put_le(swapped, state_checksum(swapped.data(), swapped.size(), 2), 8);
+  write_bytes(path("v1-word.state"), swapped);
+  Simulation sim(scene_);
+  EXPECT_EQ(load_error(sim, path("v1-word.state")),
+            path("v1-word.state") + ": checksum mismatch: the state file is corrupt");
+  expect_untouched(sim, scene_);
+}
+
+// The word checksum sees a change in any byte, in a trailing partial word, and in trailing zero bytes.
+TEST(StateChecksum, ChangesWithAnyByteAndWithTrailingZeros) {
+  std::string data(37, '\0');
+  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<char>(i * 7 + 3);
+  const uint64_t base = state_checksum(data.data(), data.size());
+  for (size_t i = 0; i < data.size(); ++i) {
+    std::string changed = data;
+    changed[i] = static_cast<char>(changed[i] ^ 0x10);
+    EXPECT_NE(state_checksum(changed.data(), changed.size()), base) << "byte " << i;
+  }
+  std::string padded = data + std::string(3, '\0');
+  EXPECT_NE(state_checksum(padded.data(), padded.size()), base);
+  EXPECT_NE(state_checksum(data.data(), 32), state_checksum((data.substr(0, 32) + std::string(8, '\0')).data(), 40));
+  EXPECT_NE(state_checksum(data.data(), data.size(), 1), base);
 }
 
 TEST_F(StateErrors, EveryTruncationIsReported) {
@@ -251,13 +295,13 @@ TEST_F(StateErrors, UnknownMissingAndRepeatedSections) {
   renamed.push_back({"COLL", "\x01\x02"});
   write_bytes(path("unknown.state"), assemble(renamed));
   EXPECT_EQ(load_error(sim, path("unknown.state")),
-            path("unknown.state") + ": section 'COLL' is unknown to this arcsim (state format version 1)");
+            path("unknown.state") + ": section 'COLL' is unknown to this arcsim (state format version 2)");
 
   renamed = sections;
   renamed[2].tag = std::string("O\0\x7f'", 4);
   write_bytes(path("binary-tag.state"), assemble(renamed));
   EXPECT_EQ(load_error(sim, path("binary-tag.state")),
-            path("binary-tag.state") + ": section 'O\\x00\\x7f\\x27' is unknown to this arcsim (state format version 1)");
+            path("binary-tag.state") + ": section 'O\\x00\\x7f\\x27' is unknown to this arcsim (state format version 2)");
 
   std::vector<Section> dropped = sections;
   dropped.erase(dropped.begin() + 3);
@@ -373,7 +417,7 @@ TEST_F(StateErrors, BadReferencesAndValuesInsideAWellFormedFile) {
     ASSERT_EQ(bytes.find(marker, at + 1), std::string::npos);
     bytes.replace(at, 8, nan);
     bytes.resize(bytes.size() - 8);
-    put_le(bytes, fnv1a64(bytes.data(), bytes.size()), 8);
+    put_le(bytes, state_checksum(bytes.data(), bytes.size()), 8);
     write_bytes(path("nan.state"), bytes);
     Simulation sim(scene_);
     const std::string error = load_error(sim, path("nan.state"));
