@@ -578,37 +578,42 @@ std::vector<int> live_numbers(const std::vector<T>& items, size_t& count) {
   return number;
 }
 
-// The rest angle each edge gets when the written file is read back without an edge record: the rest dihedral
-// as computed on the mesh the reader builds (same faces in the same order), so that the comparison below is
-// bit-exact even where edits left an edge stored in the opposite direction.
-std::vector<double> default_rest_angles_on_reload(const Mesh& mesh, const std::vector<int>& node_number,
-                                                  const std::vector<int>& vert_number) {
-  std::vector<Vec3> node_x, vert_u;
-  std::vector<int> vert_node;
-  std::vector<std::array<int, 3>> tris;
-  for (const Node& n : mesh.nodes)
-    if (!n.dead) node_x.push_back(n.x);
-  for (const Vert& v : mesh.verts) {
-    if (v.dead) continue;
-    vert_u.push_back(v.u);
-    vert_node.push_back(node_number[v.node] - 1);
-  }
-  for (const Face& f : mesh.faces)
-    if (!f.dead) tris.push_back({vert_number[f.v[0]] - 1, vert_number[f.v[1]] - 1, vert_number[f.v[2]] - 1});
+// The rest angle each edge gets when the written file is read back without an edge record, bit for bit. The
+// reader (Mesh::from_triangles) adds the faces in file order (the live faces in index order); the first of an
+// edge's two faces creates it, oriented along that face's winding, and its rest angle is the rest dihedral taken
+// in that orientation. Ours may be stored the other way round after edits (f[0] is the face running n[0] -> n[1]):
+// then the same dihedral is taken with the ends and the faces swapped, as the reader will. Boundary edges and seams
+// (the faces do not share the edge's rest verts) get 0 either way. NaN (every edge record explicit) where the
+// reader would not rebuild the same edges.
+std::vector<double> default_rest_angles_on_reload(const Mesh& mesh) {
   std::vector<double> angles(mesh.edges.size(), 0.0);
-  Mesh reloaded;
-  try {
-    reloaded = Mesh::from_triangles(node_x, vert_u, vert_node, tris);
-  } catch (const std::logic_error&) {
-    // Not a manifold: the file will not load anyway; NaN makes every edge record explicit.
-    std::fill(angles.begin(), angles.end(), std::nan(""));
-    return angles;
+  // Meshes are built and edited face by face (Mesh::add_face refuses what the reader would), so the one way the
+  // reader's rebuild can differ is two edges between the same nodes, which it would merge.
+  for (size_t e = 0; e < mesh.edges.size(); ++e) {
+    const Edge& edge = mesh.edges[e];
+    if (!edge.dead && mesh.find_edge(edge.n[0], edge.n[1]) != static_cast<int>(e)) {
+      std::fill(angles.begin(), angles.end(), std::nan(""));
+      return angles;
+    }
   }
   for (size_t e = 0; e < mesh.edges.size(); ++e) {
     const Edge& edge = mesh.edges[e];
-    if (edge.dead) continue;
-    const int twin = reloaded.find_edge(node_number[edge.n[0]] - 1, node_number[edge.n[1]] - 1);
-    angles[e] = twin == kNone ? std::nan("") : reloaded.edges[twin].rest_theta;
+    if (edge.dead || edge.is_boundary()) continue;
+    const bool reversed = edge.f[1] < edge.f[0];  // the reader meets f[1] (running n[1] -> n[0]) first
+    const int n0 = edge.n[reversed ? 1 : 0], n1 = edge.n[reversed ? 0 : 1];
+    const Face& A = mesh.faces[edge.f[reversed ? 1 : 0]];
+    const Face& B = mesh.faces[edge.f[reversed ? 0 : 1]];
+    int a0 = kNone, a1 = kNone, a2 = kNone, b0 = kNone, b1 = kNone, b3 = kNone;
+    for (int i = 0; i < 3; ++i) {
+      const int n = mesh.verts[A.v[i]].node;
+      (n == n0 ? a0 : n == n1 ? a1 : a2) = A.v[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      const int n = mesh.verts[B.v[i]].node;
+      (n == n0 ? b0 : n == n1 ? b1 : b3) = B.v[i];
+    }
+    if (a0 != b0 || a1 != b1) continue;
+    angles[e] = dihedral_angle(mesh.verts[a0].u, mesh.verts[a1].u, mesh.verts[a2].u, mesh.verts[b3].u);
   }
   return angles;
 }
@@ -661,7 +666,7 @@ void write_obj(const Mesh& mesh, const std::string& path) {
     if (f.Fp != Mat3::Identity()) append_mat3(out, "ts", f.Fp);
     if (f.damage != 0) append_line(out, "td", {f.damage});
   }
-  const std::vector<double> default_angle = default_rest_angles_on_reload(mesh, node_number, vert_number);
+  const std::vector<double> default_angle = default_rest_angles_on_reload(mesh);
   for (size_t e = 0; e < mesh.edges.size(); ++e) {
     const Edge& edge = mesh.edges[e];
     if (edge.dead) continue;
