@@ -47,26 +47,36 @@ void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs)
   }
   for (int c = 0; c < node_count; ++c) col_start_[c + 1] += col_start_[c];
 
-  // Scalar CSC of the lower triangle: column 3c+b holds, for each block (r, c) of node column c in row order,
-  // rows 3r..3r+2 (or 3c+b..3c+2 for the diagonal block).
+  // Scalar CSC of the upper triangle (CHOLMOD transposes a lower one twice before factorising it, an upper one
+  // once). Block k, stored as (row R, column C) with R >= C, appears there transposed at (C, R): scalar column
+  // 3R+b holds, for each block of node row R in column order, rows 3C..3C+2 (or 3R..3R+b for the diagonal block,
+  // which comes last).
   const int n = 3 * node_count;
+  std::vector<int> row_start(node_count + 1, 0);
+  for (int r : block_row_) ++row_start[r + 1];
+  for (int r = 0; r < node_count; ++r) row_start[r + 1] += row_start[r];
+  std::vector<int> row_blocks(block_row_.size());
+  {
+    std::vector<int> next(row_start.begin(), row_start.end() - 1);
+    for (size_t k = 0; k < block_row_.size(); ++k) row_blocks[next[block_row_[k]]++] = static_cast<int>(k);
+  }
   std::vector<int> outer(n + 1, 0);
-  for (int c = 0; c < node_count; ++c) {
-    const int blocks_in_col = col_start_[c + 1] - col_start_[c];  // includes the diagonal block
-    for (int b = 0; b < 3; ++b) outer[3 * c + b + 1] = 3 * (blocks_in_col - 1) + (3 - b);
+  for (int r = 0; r < node_count; ++r) {
+    const int blocks_in_row = row_start[r + 1] - row_start[r];  // includes the diagonal block
+    for (int b = 0; b < 3; ++b) outer[3 * r + b + 1] = 3 * (blocks_in_row - 1) + (b + 1);
   }
   for (int j = 0; j < n; ++j) outer[j + 1] += outer[j];
   const int nnz = outer[n];
   std::vector<int> inner(nnz);
   value_offset_.assign(3 * pairs.size(), 0);
-  for (int c = 0; c < node_count; ++c) {
+  for (int r = 0; r < node_count; ++r) {
     for (int b = 0; b < 3; ++b) {
-      int pos = outer[3 * c + b];
-      for (int k = col_start_[c]; k < col_start_[c + 1]; ++k) {
-        const int r = block_row_[k];
+      int pos = outer[3 * r + b];
+      for (int i = row_start[r]; i < row_start[r + 1]; ++i) {
+        const int k = row_blocks[i], c = block_col_[k];
         value_offset_[3 * k + b] = pos;
-        const int first = (r == c) ? b : 0;
-        for (int a = first; a < 3; ++a) inner[pos++] = 3 * r + a;
+        const int last = (c == r) ? b : 2;
+        for (int a = 0; a <= last; ++a) inner[pos++] = 3 * c + a;
       }
     }
   }
@@ -109,7 +119,8 @@ void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
     const bool diagonal = pattern->block_row(k) == pattern->block_col(k);
     for (int b = 0; b < 3; ++b) {
       const int offset = pattern->block_value_offset(k, b);
-      for (int a = diagonal ? b : 0; a < 3; ++a) values[offset + a - (diagonal ? b : 0)] = blocks[k](a, b);
+      const int last = diagonal ? b : 2;
+      for (int a = 0; a <= last; ++a) values[offset + a] = blocks[k](b, a);
     }
   }
 }
@@ -133,7 +144,7 @@ bool CholeskySolver::factorize(const BlockSystem& system) {
   if (!llt_ || analysed_pattern_ != id) {
     matrix_ = system.pattern->csc_structure();
     system.to_csc(matrix_);
-    llt_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>();
+    llt_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>>();
     llt_->analyzePattern(matrix_);
     analysed_pattern_ = id;
     ++analyses_;

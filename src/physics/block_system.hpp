@@ -3,7 +3,7 @@
 // The sparsity pattern depends only on which node pairs interact (faces, hinges, and any extra pairs such as
 // contacts), so it is built once per topology and its CHOLMOD symbolic analysis is reused until it changes.
 // Element matrices are accumulated into 3x3 blocks in a fixed order (deterministic whatever the thread count),
-// then copied into the lower triangle of a compressed-column matrix that CHOLMOD factorises.
+// then copied into the upper triangle of a compressed-column matrix that CHOLMOD factorises.
 #pragma once
 
 #include <array>
@@ -38,8 +38,10 @@ class BlockPattern {
   // Identifies the pattern: equal ids mean identical structure (symbolic factorisation can be reused).
   uint64_t id() const { return id_; }
 
-  // Compressed-column structure of the lower triangle of the 3n x 3n matrix and, for each block, where its
-  // entries go: value index of entry (3*row + a, 3*col + b) is block_offset(k, b) + a - (diagonal ? b : 0).
+  // Compressed-column structure of the upper triangle of the 3n x 3n matrix and, for each block k (stored as
+  // (row, col) with row >= col), where its entries go: entry (a, b) of block k, i.e. matrix entry
+  // (3*row + a, 3*col + b) = (3*col + b, 3*row + a), is at value index block_value_offset(k, a) + b (b <= a on a
+  // diagonal block).
   const Eigen::SparseMatrix<double>& csc_structure() const { return csc_; }
   int block_row(int k) const { return block_row_[k]; }
   int block_col(int k) const { return block_col_[k]; }
@@ -70,7 +72,7 @@ struct BlockSystem {
   void add_diagonal(int node, const Mat3& K) { blocks[pattern->block_index(node, node)] += K; }
   // y = A x (full symmetric product), for tests and residuals.
   VecX multiply(const VecX& x) const;
-  // Fills `out` (with the pattern's structure) with the lower triangle.
+  // Fills `out` (with the pattern's structure) with the upper triangle.
   void to_csc(Eigen::SparseMatrix<double>& out) const;
 };
 
@@ -118,7 +120,7 @@ class CholeskySolver {
   int analyses() const { return analyses_; }
 
  private:
-  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>> llt_;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>> llt_;
   Eigen::SparseMatrix<double> matrix_;
   uint64_t analysed_pattern_ = 0;
   int analyses_ = 0;

@@ -49,8 +49,8 @@ TEST(BlockSystem, MatchesDenseAssemblyAndSolves) {
 
   Eigen::SparseMatrix<double> csc;
   system.to_csc(csc);
-  const Eigen::MatrixXd lower = Eigen::MatrixXd(csc);
-  EXPECT_LT((lower - Eigen::MatrixXd(dense.triangularView<Eigen::Lower>())).norm(), 1e-12 * dense.norm());
+  const Eigen::MatrixXd upper = Eigen::MatrixXd(csc);
+  EXPECT_LT((upper - Eigen::MatrixXd(dense.triangularView<Eigen::Upper>())).norm(), 1e-12 * dense.norm());
 
   system.rhs = VecX::Random(3 * n);
   CholeskySolver solver;
