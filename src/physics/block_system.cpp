@@ -30,12 +30,21 @@ void sort_unique_pairs(std::vector<std::pair<int, int>>& pairs, int key_count) {
 }
 
 void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs) {
-  node_count_ = node_count;
   // Held as (col, row) with row >= col, so that sorting them gives column-major order: by column, then row.
   for (auto& p : pairs)
     if (p.first > p.second) std::swap(p.first, p.second);
   for (int i = 0; i < node_count; ++i) pairs.emplace_back(i, i);
   sort_unique_pairs(pairs, node_count);
+
+  // The same structure as before (a remesh that changed nothing, contacts that came and went): keep the id, so
+  // that the solver reuses its symbolic analysis.
+  if (id_ != 0 && node_count == node_count_ && pairs.size() == block_row_.size()) {
+    bool same = true;
+    for (size_t k = 0; k < pairs.size() && same; ++k)
+      same = pairs[k].first == block_col_[k] && pairs[k].second == block_row_[k];
+    if (same) return;
+  }
+  node_count_ = node_count;
 
   block_row_.resize(pairs.size());
   block_col_.resize(pairs.size());

@@ -68,6 +68,27 @@ TEST(BlockSystem, MatchesDenseAssemblyAndSolves) {
   for (int i = 0; i < n; ++i) system2.add_diagonal(i, Mat3::Identity());
   ASSERT_TRUE(solver.factorize(system2));
   EXPECT_EQ(solver.analyses(), 2);
+  // Rebuilt with the same structure (pairs in another order, repeated): same id, the analysis is reused and the
+  // solution is the same. With a pair more, or a node more: a new id.
+  const uint64_t id = pattern.id();
+  std::vector<std::pair<int, int>> reordered(pairs.rbegin(), pairs.rend());
+  reordered.insert(reordered.end(), pairs.begin(), pairs.begin() + 5);
+  pattern.build(n, reordered);
+  EXPECT_EQ(pattern.id(), id);
+  ASSERT_TRUE(solver.factorize(system));
+  EXPECT_EQ(solver.analyses(), 3);  // system2's pattern was the last one analysed
+  ASSERT_TRUE(solver.factorize(system));
+  EXPECT_EQ(solver.analyses(), 3);
+  EXPECT_EQ(solver.solve(system.rhs), sol);
+  std::vector<std::pair<int, int>> more = pairs;
+  int a = 0, b = 1;
+  while (pattern.block_index(a, b) >= 0) b == n - 1 ? (++a, b = a + 1) : ++b;
+  more.emplace_back(a, b);
+  pattern.build(n, more);
+  EXPECT_NE(pattern.id(), id);
+  const uint64_t id_more = pattern.id();
+  pattern.build(n + 1, more);
+  EXPECT_NE(pattern.id(), id_more);
 }
 
 // An element with one node in two slots (a bending element whose wings coincide, at a valence-3 node) adds
