@@ -160,15 +160,17 @@ bool CholeskySolver::factorize(const BlockSystem& system) {
   } else {
     system.to_csc(matrix_);
   }
-  // CHOLMOD's supernodal numeric phase opens OpenMP teams of a compiled-in size (4 threads in Debian's build),
-  // whatever the machine or --threads: on 2 cores those teams oversubscribe and their barrier waits cost more
-  // than the factorisation itself (measured: 7.3 s -> 4.8 s on sphere.json to 1.2 s). Dynamic teams cap them
-  // at the thread count we run with and the free cores. The parallel part only copies entries into distinct
-  // places, so the factor does not depend on the team size.
-  const int dynamic_before = omp_get_dynamic();
-  omp_set_dynamic(1);
+  // CHOLMOD's supernodal numeric phase opens an OpenMP team of a compiled-in size (4 threads in Debian's build)
+  // for every supernode, whatever the machine or --threads; its parallel part only copies entries into distinct
+  // places (the arithmetic is in the serial BLAS). On 2 cores those teams oversubscribed and their barriers cost
+  // more than the factorisation (sphere.json to 1.2 s: 7.3 s -> 4.8 s with dynamic teams), and dynamic teams
+  // still cost a load-average query, an affinity query and a futex per supernode (~420 per step of
+  // paper-tearing.json, 145 000 system calls in its first 200 steps). With no active parallel level allowed,
+  // every such region runs on the calling thread at once. The factor does not depend on the team size.
+  const int levels_before = omp_get_max_active_levels();
+  omp_set_max_active_levels(0);
   llt_->factorize(matrix_);
-  omp_set_dynamic(dynamic_before);
+  omp_set_max_active_levels(levels_before);
   return llt_->info() == Eigen::Success;
 }
 
