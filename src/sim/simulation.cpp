@@ -233,7 +233,9 @@ CollisionSettings Simulation::collision_settings() const {
   s.stiffness = magic.collision_stiffness * (passive() ? kPassiveStiffnessFactor : 1.0);
   s.friction = scene_.friction;
   s.obstacle_friction = scene_.obs_friction;
-  s.neighbour_thickness = fracture.opening.lip_gap;
+  // Material neighbours (collision/proximity.hpp) exist to let a crack's lips close; a scene that cannot crack
+  // keeps the full thickness between all parts of a sheet, as ARCSim has it (its frames stay as they were).
+  s.neighbour_thickness = scene_.enabled("fracture") ? fracture.opening.lip_gap : s.repulsion_thickness;
   s.step = step_;
   // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
   for (const Obstacle& o : obstacles) {

@@ -178,6 +178,9 @@ class Simulation {
   double end_frame() const { return end_frame_; }
   // Total number of frames the run will produce (infinity if unbounded).
   double total_frames() const;
+  // The collision module's settings for the current step (thicknesses, stiffness, friction, floor, the
+  // thickness between material neighbours).
+  CollisionSettings collision_settings() const;
 
  private:
   void load_cloth(const ClothSpec& spec, int index);
@@ -186,7 +189,6 @@ class Simulation {
   void move_obstacles(double t);
   ExternalLoads loads_for(int cloth, double t) const;
   void refresh_elements();
-  CollisionSettings collision_settings() const;
   // Proximity terms per cloth (empty lists when the module is disabled).
   std::vector<std::vector<ContactTerm>> proximity_step(double dt);
   // The implicit step of every cloth with its loads and step_contacts_.
