@@ -1,12 +1,18 @@
 #!/usr/bin/env python3
 """Wall time of ARCSim's own example scenes, for the speed comparison with ARCSim 0.3.1.
 
-Usage: tools/bench_arcsim_scenes.py [--shared DIR] [--threads N] [--repeat K] [scene:seconds ...]
+Usage: tools/bench_arcsim_scenes.py [--shared DIR] [--threads N] [--repeat K] [--arcsim PATH]
+                                    [scene:seconds ...]
 
 Runs `bin/arcsim simulate` on each scene of DIR/arcsim-0.3-scenes/conf (default ../shared) for the given
 simulated seconds (default: sphere:2, flag:2, square:2), writing into a temporary folder, and prints per scene
-the wall time (best of K runs), the steps and the per-module wall times read from log.jsonl. The ARCSim 0.3.1
-figures quoted in docs/benchmarks.md were measured on the same machine class.
+the wall time (best of K runs), the steps and the per-module wall times read from log.jsonl.
+
+With --arcsim PATH (an ARCSim 0.3.1 binary, e.g. /work/anchor/build/arcsim), each scene is then also run by
+ARCSim in the same invocation, one engine after the other (never both at once), and a second table gives both
+engines' stepping wall (start-up and ARCSim's initial relaxation excluded, measured as tools/bench_fracture.py
+does: ours from log.jsonl, ARCSim from the arrival of its per-step "Sim frame" lines), best of K runs each, and
+ARCSim's over ours: the figure of the 5x goal.
 """
 import argparse
 import json
@@ -15,6 +21,9 @@ import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_fracture  # noqa: E402  (the two engines' runners, shared with the fracture benchmark)
 
 MODULES = ["physics", "collision", "remeshing", "plasticity", "fracture", "output"]
 
@@ -44,6 +53,8 @@ def main():
     parser.add_argument("--threads", type=int, default=0)
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--binary", default=os.path.join(root, "bin", "arcsim"))
+    parser.add_argument("--arcsim", help="ARCSim 0.3.1 binary: also run each scene with it and print the ratio")
+    parser.add_argument("--timeout", type=float, default=3600.0, help="per run, with --arcsim (s)")
     parser.add_argument("scenes", nargs="*", default=["sphere:2", "flag:2", "square:2"])
     args = parser.parse_args()
     scenes_dir = os.path.join(args.shared, "arcsim-0.3-scenes")
@@ -63,6 +74,32 @@ def main():
         per_step = 1000 * wall / steps if steps else float("nan")
         print(f"{scene:<14} {seconds:>6.2f} {wall:>8.2f} {steps:>6d} {per_step:>8.2f} {faces:>6d}  "
               + " ".join(f"{modules[m]:>9.2f}" for m in MODULES))
+    if args.arcsim:
+        side_by_side(args, scenes_dir)
+
+
+def side_by_side(args, scenes_dir):
+    """Both engines on each scene, one after the other; stepping walls (best of --repeat) and their ratio."""
+    print()
+    print(f"{'scene':<14} {'sim s':>6} {'ours s':>8} {'ARCSim s':>9} {'ARCSim/ours':>12}  status")
+    for item in args.scenes:
+        scene, _, seconds = item.partition(":")
+        seconds = float(seconds or 2)
+        best = {}
+        for _ in range(max(1, args.repeat)):
+            with tempfile.TemporaryDirectory() as tmp:
+                runs = [bench_fracture.run_ours(args.binary, scenes_dir, scene, seconds, args.threads, args.timeout,
+                                                os.path.join(tmp, "ours")),
+                        bench_fracture.run_arcsim(args.arcsim, scenes_dir, scene, seconds, args.timeout,
+                                                  os.path.join(tmp, "arcsim"))]
+            for r in runs:
+                if r["engine"] not in best or r["stepping_wall"] < best[r["engine"]]["stepping_wall"]:
+                    best[r["engine"]] = r
+        ours, arcsim = best["ours"], best["ARCSim"]
+        ok = ours["status"] == "done" and arcsim["status"] == "done" and ours["stepping_wall"] > 0
+        ratio = arcsim["stepping_wall"] / ours["stepping_wall"] if ok else float("nan")
+        print(f"{scene:<14} {seconds:>6.2f} {ours['stepping_wall']:>8.2f} {arcsim['stepping_wall']:>9.2f} "
+              f"{ratio:>11.2f}x  ours {ours['status']}, ARCSim {arcsim['status']}")
 
 
 if __name__ == "__main__":
