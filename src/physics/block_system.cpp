@@ -56,10 +56,17 @@ void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs)
   }
   for (int c = 0; c < node_count; ++c) col_start_[c + 1] += col_start_[c];
 
+  layout_ready_ = false;
+  id_ = next_pattern_id++;
+}
+
+void BlockPattern::prepare_layout() const {
+  if (layout_ready_) return;
   // Scalar CSC of the upper triangle (CHOLMOD transposes a lower one twice before factorising it, an upper one
   // once). Block k, stored as (row R, column C) with R >= C, appears there transposed at (C, R): scalar column
   // 3R+b holds, for each block of node row R in column order, rows 3C..3C+2 (or 3R..3R+b for the diagonal block,
   // which comes last).
+  const int node_count = node_count_;
   const int n = 3 * node_count;
   std::vector<int> row_start(node_count + 1, 0);
   for (int r : block_row_) ++row_start[r + 1];
@@ -77,7 +84,7 @@ void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs)
   for (int j = 0; j < n; ++j) outer[j + 1] += outer[j];
   const int nnz = outer[n];
   std::vector<int> inner(nnz);
-  value_offset_.assign(3 * pairs.size(), 0);
+  value_offset_.assign(3 * block_row_.size(), 0);
   for (int r = 0; r < node_count; ++r) {
     for (int b = 0; b < 3; ++b) {
       int pos = outer[3 * r + b];
@@ -94,7 +101,7 @@ void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs)
   std::copy(outer.begin(), outer.end(), csc_.outerIndexPtr());
   std::copy(inner.begin(), inner.end(), csc_.innerIndexPtr());
   std::fill(csc_.valuePtr(), csc_.valuePtr() + nnz, 0.0);
-  id_ = next_pattern_id++;
+  layout_ready_ = true;
 }
 
 int BlockPattern::block_index(int i, int j) const {
@@ -121,6 +128,7 @@ VecX BlockSystem::multiply(const VecX& x) const {
 }
 
 void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
+  pattern->prepare_layout();
   if (out.rows() != pattern->csc_structure().rows() || out.nonZeros() != pattern->csc_structure().nonZeros())
     out = pattern->csc_structure();
   double* values = out.valuePtr();
@@ -150,6 +158,7 @@ CholeskySolver& CholeskySolver::operator=(CholeskySolver&& other) noexcept {
 
 bool CholeskySolver::factorize(const BlockSystem& system) {
   const uint64_t id = system.pattern->id();
+  system.pattern->prepare_layout();
   if (!llt_ || analysed_pattern_ != id) {
     matrix_ = system.pattern->csc_structure();
     system.to_csc(matrix_);

@@ -38,13 +38,17 @@ class BlockPattern {
   // Identifies the pattern: equal ids mean identical structure (symbolic factorisation can be reused).
   uint64_t id() const { return id_; }
 
-  // Compressed-column structure of the upper triangle of the 3n x 3n matrix and, for each block k (stored as
-  // (row, col) with row >= col), where its entries go: entry (a, b) of block k, i.e. matrix entry
-  // (3*row + a, 3*col + b) = (3*col + b, 3*row + a), is at value index block_value_offset(k, a) + b (b <= a on a
-  // diagonal block).
-  const Eigen::SparseMatrix<double>& csc_structure() const { return csc_; }
   int block_row(int k) const { return block_row_[k]; }
   int block_col(int k) const { return block_col_[k]; }
+
+  // The layout of the factorised matrix, built on first use after each change of structure: only patterns that
+  // are factorised pay for it (a step may rebuild its pattern more than once before it factorises). The
+  // compressed-column structure of the upper triangle of the 3n x 3n matrix and, for each block k (stored as
+  // (row, col) with row >= col), where its entries go: entry (a, b) of block k, i.e. matrix entry
+  // (3*row + a, 3*col + b) = (3*col + b, 3*row + a), is at value index block_value_offset(k, a) + b (b <= a on a
+  // diagonal block). The two accessors require prepare_layout().
+  void prepare_layout() const;
+  const Eigen::SparseMatrix<double>& csc_structure() const { return csc_; }
   int block_value_offset(int k, int b) const { return value_offset_[3 * k + b]; }
 
  private:
@@ -52,8 +56,10 @@ class BlockPattern {
   std::vector<int> col_start_;   // per node column: first block index
   std::vector<int> block_row_;   // per block: row node (>= column node)
   std::vector<int> block_col_;
-  std::vector<int> value_offset_;
-  Eigen::SparseMatrix<double> csc_;
+  // The factorisation layout (prepare_layout).
+  mutable bool layout_ready_ = false;
+  mutable std::vector<int> value_offset_;
+  mutable Eigen::SparseMatrix<double> csc_;
   uint64_t id_ = 0;
 };
 

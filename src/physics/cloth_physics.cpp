@@ -33,6 +33,7 @@ std::vector<std::pair<int, int>> sorted_node_pairs(std::vector<std::pair<int, in
 
 // Builds the block pattern from the element and contact pairs and refreshes the elements' block ids.
 void rebuild_pattern(ElementCache& cache) {
+  cache.pattern_stale = false;
   std::vector<std::pair<int, int>> pairs = cache.element_pairs;
   pairs.insert(pairs.end(), cache.contact_pairs.begin(), cache.contact_pairs.end());
   cache.pattern.build(static_cast<int>(cache.node_mass.size()), std::move(pairs));
@@ -62,7 +63,8 @@ void update_node_masses(Mesh& mesh, const std::vector<Material>& materials, cons
   }
 }
 
-void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache) {
+void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache,
+                         PatternBuild pattern_build) {
   cache.faces.clear();
   cache.bending.clear();
   std::vector<std::pair<int, int>> pairs;
@@ -89,15 +91,22 @@ void build_element_cache(const Mesh& mesh, const std::vector<Material>& material
   for (size_t n = 0; n < mesh.nodes.size(); ++n) cache.node_mass[n] = mesh.nodes[n].mass;
   // Same connectivity (only rest state, thickness or plasticity changed): keep the pattern and its contact
   // pairs, so CHOLMOD's symbolic analysis is reused (plastic flow changes faces every step while it lasts).
-  if (element_pairs == cache.element_pairs && cache.pattern.node_count() == static_cast<int>(mesh.nodes.size()) &&
-      cache.pattern.block_count() > 0) {
+  if (!cache.pattern_stale && element_pairs == cache.element_pairs &&
+      cache.pattern.node_count() == static_cast<int>(mesh.nodes.size()) && cache.pattern.block_count() > 0) {
     for (auto& f : cache.faces) f.blocks = element_block_ids<3>(cache.pattern, f.dofs);
     for (auto& b : cache.bending) b.blocks = element_block_ids<6>(cache.pattern, b.dofs);
     return;
   }
   cache.element_pairs = std::move(element_pairs);
   cache.contact_pairs.clear();
-  rebuild_pattern(cache);
+  if (pattern_build == PatternBuild::kDeferred)
+    cache.pattern_stale = true;
+  else
+    rebuild_pattern(cache);
+}
+
+void ensure_pattern(ElementCache& cache) {
+  if (cache.pattern_stale) rebuild_pattern(cache);
 }
 
 bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts) {
@@ -116,7 +125,7 @@ bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>&
   // Keeping stale pairs costs little (zero blocks) and avoids re-analysing the matrix every time a contact
   // ends; shrink once they clearly dominate.
   const bool bloated = cache.contact_pairs.size() > 2 * extra.size() + 256;
-  if (!missing && !bloated) return false;
+  if (!missing && !bloated && !cache.pattern_stale) return false;
   cache.contact_pairs = std::move(extra);
   rebuild_pattern(cache);
   return true;
@@ -175,6 +184,8 @@ namespace {
 // Element results computed in parallel, then scattered serially in element order (deterministic).
 template <int N>
 struct ElementResult {
+  // Every field is written before it is read: no zero-filling of the (large) buffer on allocation.
+  ElementResult() {}
   double energy;
   Eigen::Matrix<double, 3 * N, 1> rhs;
   Eigen::Matrix<double, 3 * N, 3 * N> K;
@@ -373,6 +384,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
                          double dt, StepTiming* timing) {
   const auto t0 = std::chrono::steady_clock::now();
   const int n = static_cast<int>(mesh.nodes.size());
+  ensure_pattern(cache);
   BlockSystem system;
   system.reset(cache.pattern);
   assemble_implicit_euler(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system);

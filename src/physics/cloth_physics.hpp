@@ -30,6 +30,7 @@ struct ElementCache {
   // Node pairs of the pattern: those of the elements, and extra ones for contacts (update_contact_pattern).
   std::vector<std::pair<int, int>> element_pairs;  // (row >= col), sorted, unique
   std::vector<std::pair<int, int>> contact_pairs;  // extra pairs not among element_pairs, sorted, unique
+  bool pattern_stale = false;  // element pairs changed since the pattern was built (PatternBuild::kDeferred)
 };
 
 // A contact (proximity) term over up to four nodes, linearised for the implicit step. The gap
@@ -52,12 +53,20 @@ void update_node_masses(Mesh& mesh, const std::vector<Material>& materials);
 // The same for the listed nodes only (the nodes an edit's faces touch): bit-identical values, cost of their fans.
 void update_node_masses(Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& nodes);
 
+// When build_element_cache builds the block pattern: at once, or (kDeferred) at the next update_contact_pattern
+// or ensure_pattern, so that a step that adds contact pairs builds it (and its block ids) once, not twice.
+enum class PatternBuild { kNow, kDeferred };
+
 // Builds the element cache (and the block pattern) for the mesh's current topology and rest state.
-void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache);
+void build_element_cache(const Mesh& mesh, const std::vector<Material>& materials, ElementCache& cache,
+                         PatternBuild pattern_build = PatternBuild::kNow);
+
+// Builds the block pattern if build_element_cache deferred it.
+void ensure_pattern(ElementCache& cache);
 
 // Makes the pattern contain every node pair coupled by `contacts`. The pattern (and with it the CHOLMOD
-// symbolic analysis) is rebuilt only when a needed pair is missing, or when far more contact pairs are kept
-// than needed. Returns true if it was rebuilt.
+// symbolic analysis) is rebuilt only when a needed pair is missing, when far more contact pairs are kept
+// than needed, or when it was deferred. Returns true if it was rebuilt.
 bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts);
 
 // Total elastic energy (J) of the cloth at its current world positions.

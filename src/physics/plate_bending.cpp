@@ -51,17 +51,26 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
   }
   if (hessian == HessianKind::kNone) return out;
 
-  // Gauss-Newton part 2 sum_ij Q_ij grad_i grad_j^T, scattered to element slots.
+  // Gauss-Newton part 2 sum_ij Q_ij grad_i grad_j^T. Slot p's rows of the three gradients form a 3x3 matrix
+  // G_p (column i: hinge i's gradient at slot p, zero where slot p is not in hinge i), so that block (p, q) is
+  // 2 G_p Q G_q^T: six products G_p Q, then the upper blocks, mirrored (Q is symmetric).
+  out.hessian.setZero();
+  std::array<Mat3, 6> G;
+  for (Mat3& g : G) g.setZero();
   for (int i = 0; i < 3; ++i) {
     if (!has_wing[i]) continue;
-    const auto si = hinge_slots(i);
-    for (int j = 0; j < 3; ++j) {
-      if (!has_wing[j] || Q(i, j) == 0) continue;
-      const auto sj = hinge_slots(j);
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-          out.hessian.block<3, 3>(3 * si[a], 3 * sj[b]) +=
-              2 * Q(i, j) * grad[i].segment<3>(3 * a) * grad[j].segment<3>(3 * b).transpose();
+    const auto s = hinge_slots(i);
+    for (int a = 0; a < 4; ++a) G[s[a]].col(i) = grad[i].segment<3>(3 * a);
+  }
+  std::array<Mat3, 6> GQ;
+  for (int p = 0; p < 6; ++p) GQ[p] = 2 * G[p] * Q;
+  for (int p = 0; p < 6; ++p) {
+    if (p >= 3 && !has_wing[p - 3]) continue;
+    for (int q = p; q < 6; ++q) {
+      if (q >= 3 && !has_wing[q - 3]) continue;
+      const Mat3 block = GQ[p] * G[q].transpose();
+      out.hessian.block<3, 3>(3 * p, 3 * q) = block;
+      if (q != p) out.hessian.block<3, 3>(3 * q, 3 * p) = block.transpose();
     }
   }
   if (hessian == HessianKind::kExact) {

@@ -38,7 +38,7 @@ Mat3 plate_bending_matrix(const std::array<double, 3>& lengths, const std::array
 struct PlateBendingTerms {
   double energy = 0;             // J
   Vec18 gradient = Vec18::Zero();  // N, stacked (c0, c1, c2, w0, w1, w2)
-  Mat18 hessian = Mat18::Zero();   // N/m
+  Mat18 hessian;                   // N/m; set only when a Hessian is asked for (not with HessianKind::kNone)
   Vec3 theta = Vec3::Zero();       // world dihedral angles of the three edges (rad; 0 on boundary edges)
 };
 

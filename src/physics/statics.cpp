@@ -47,6 +47,7 @@ StaticResult solve_static(Mesh& mesh, ElementCache& cache, CholeskySolver& solve
       result.converged = true;
       return result;
     }
+    ensure_pattern(cache);
     BlockSystem system;
     system.reset(cache.pattern);
     InternalAssembly how;  // H dx = f

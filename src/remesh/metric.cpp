@@ -80,6 +80,23 @@ Mat2 metric_max(const std::vector<Mat2>& metrics) {
   }
   if (!(scale > 0)) return Mat2::Zero();
   const double tolerance = 1e-10 * scale;
+  // A circle inside another (M_j <= M_i: a zero term, a weaker criterion) cannot shape the enclosing circle:
+  // drop it before the search, which is cubic in the count (sizing passes six terms, most often two or three
+  // of them nonzero). Of equal circles the first stays.
+  {
+    std::vector<Circle> kept;
+    for (size_t j = 0; j < circles.size(); ++j) {
+      bool inside = false;
+      for (size_t i = 0; i < circles.size() && !inside; ++i) {
+        if (i == j) continue;
+        const double slack = circles[i].r - circles[j].r - (circles[j].c - circles[i].c).norm();
+        const bool equal = circles[i].r == circles[j].r && circles[i].c == circles[j].c;
+        inside = equal ? i < j : slack >= 0;
+      }
+      if (!inside) kept.push_back(circles[j]);
+    }
+    circles.swap(kept);
+  }
   const size_t n = circles.size();
 
   // Always valid fallback: centred at the origin.

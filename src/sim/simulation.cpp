@@ -208,7 +208,8 @@ void Simulation::refresh_elements() {
   for (Cloth& cloth : cloths) {
     if (!cloth.elements_dirty) continue;
     update_node_masses(cloth.mesh, cloth.materials);
-    build_element_cache(cloth.mesh, cloth.materials, cloth.elements);
+    // The pattern waits for the step's contact pairs (physics_step), so that it is built once.
+    build_element_cache(cloth.mesh, cloth.materials, cloth.elements, PatternBuild::kDeferred);
     cloth.elements_dirty = false;
   }
 }
