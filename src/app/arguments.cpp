@@ -89,4 +89,16 @@ int integer_argument(const std::string& command, const std::string& option, cons
   return static_cast<int>(value);
 }
 
+void frame_range_argument(const std::string& command, const std::string& text, int& first, int& last) {
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) {
+    first = last = integer_argument(command, "--frames", text, 0, 1000000000);
+    return;
+  }
+  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+  if (!a.empty()) first = integer_argument(command, "--frames", a, 0, 1000000000);
+  if (!b.empty()) last = integer_argument(command, "--frames", b, 0, 1000000000);
+  if (first > last) throw InputError(command + ": --frames: empty range '" + text + "'");
+}
+
 }  // namespace arcsim

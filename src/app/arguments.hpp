@@ -32,4 +32,8 @@ double number_argument(const std::string& command, const std::string& option, co
 int integer_argument(const std::string& command, const std::string& option, const std::string& text, int min,
                      int max);
 
+// A frame range "A:B", "A:", ":B" or "N" (frames >= 0) into first/last (limits left as they are where the text
+// omits them), or InputError naming --frames.
+void frame_range_argument(const std::string& command, const std::string& text, int& first, int& last);
+
 }  // namespace arcsim

@@ -1,6 +1,7 @@
 #include <algorithm>
 
 #include "app/command.hpp"
+#include "app/inspect_command.hpp"
 #include "app/replay_command.hpp"
 #include "app/resume_command.hpp"
 #include "app/simulate_command.hpp"
@@ -14,6 +15,8 @@ const std::vector<Command>& command_table() {
       {"simulate", "run a scene offline and write its frames to a folder", kSimulateHelp, run_simulate_command},
       {"resume", "continue a run from a saved frame of its output folder", kResumeHelp, run_resume_command},
       {"replay", "render the saved frames of a run to PNG images, off-screen", kReplayHelp, run_replay_command},
+      {"inspect", "check and measure the saved frames of a run: valid mesh, intersections, pieces", kInspectHelp,
+       run_inspect_command},
   };
   return table;
 }

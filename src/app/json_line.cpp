@@ -66,4 +66,28 @@ JsonLine& JsonLine::text(const char* name, const std::string& value) {
   return *this;
 }
 
+JsonLine& JsonLine::numbers(const char* name, const std::vector<double>& values) {
+  key(name);
+  body_ += '[';
+  for (size_t i = 0; i < values.size(); ++i) body_ += (i ? "," : "") + json_number(values[i]);
+  body_ += ']';
+  return *this;
+}
+
+JsonLine& JsonLine::integers(const char* name, const std::vector<long long>& values) {
+  key(name);
+  body_ += '[';
+  for (size_t i = 0; i < values.size(); ++i) body_ += (i ? "," : "") + std::to_string(values[i]);
+  body_ += ']';
+  return *this;
+}
+
+JsonLine& JsonLine::objects(const char* name, const std::vector<JsonLine>& values) {
+  key(name);
+  body_ += '[';
+  for (size_t i = 0; i < values.size(); ++i) body_ += (i ? "," : "") + values[i].str();
+  body_ += ']';
+  return *this;
+}
+
 }  // namespace arcsim

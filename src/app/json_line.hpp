@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace arcsim {
 
@@ -15,6 +16,10 @@ class JsonLine {
   JsonLine& object(const char* key, const JsonLine& inner);
   // A string value, escaped (quotes, backslashes and control characters).
   JsonLine& text(const char* key, const std::string& value);
+  // Arrays of numbers (as number()), of integers, and of objects.
+  JsonLine& numbers(const char* key, const std::vector<double>& values);
+  JsonLine& integers(const char* key, const std::vector<long long>& values);
+  JsonLine& objects(const char* key, const std::vector<JsonLine>& values);
   std::string str() const { return "{" + body_ + "}"; }
 
  private:

@@ -1,7 +1,10 @@
 #include "app/output_files.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
 
 namespace arcsim {
 
@@ -47,6 +50,42 @@ bool is_output_file_name(const std::string& name) {
   const bool obj = name.size() > 4 && name.compare(name.size() - 4, 4, ".obj") == 0;
   if (!obj) return false;
   return std::isdigit(static_cast<unsigned char>(name[0])) || name.compare(0, 3, "obs") == 0;
+}
+
+std::map<int, SavedFrameFiles> find_saved_frames(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::map<int, SavedFrameFiles> frames;
+  std::error_code ec;
+  std::map<int, std::string> static_obstacles;
+  std::map<int, std::map<int, std::string>> moving;  // frame -> obstacle -> file
+  std::map<int, std::map<int, std::string>> cloth_files;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    int frame = -1, index = -1;
+    char tail = 0;
+    if (std::sscanf(name.c_str(), "%d_obs%d.ob%c", &frame, &index, &tail) == 3 && tail == 'j')
+      moving[frame][index] = entry.path().string();
+    else if (std::sscanf(name.c_str(), "obs%d.ob%c", &index, &tail) == 2 && tail == 'j')
+      static_obstacles[index] = entry.path().string();
+    else if (std::sscanf(name.c_str(), "%d_%d.ob%c", &frame, &index, &tail) == 3 && tail == 'j' &&
+             name == cloth_frame_file_name(frame, index))
+      cloth_files[frame][index] = entry.path().string();
+  }
+  int obstacle_count = 0;
+  for (const auto& [i, f] : static_obstacles) obstacle_count = std::max(obstacle_count, i + 1);
+  for (const auto& [frame, files] : moving)
+    for (const auto& [i, f] : files) obstacle_count = std::max(obstacle_count, i + 1);
+  for (const auto& [frame, files] : cloth_files) {
+    SavedFrameFiles ff;
+    for (int c = 0; files.count(c); ++c) ff.cloths.push_back(files.at(c));
+    if (ff.cloths.empty()) continue;
+    for (int i = 0; i < obstacle_count; ++i) {
+      if (moving.count(frame) && moving[frame].count(i)) ff.obstacles.push_back(moving[frame][i]);
+      else if (static_obstacles.count(i)) ff.obstacles.push_back(static_obstacles[i]);
+    }
+    frames[frame] = ff;
+  }
+  return frames;
 }
 
 }  // namespace arcsim

@@ -1,7 +1,9 @@
 // Names of the files the simulate command writes into its output folder (docs/file-formats.md).
 #pragma once
 
+#include <map>
 #include <string>
+#include <vector>
 
 namespace arcsim {
 
@@ -19,6 +21,16 @@ std::string state_file_name(int frame);
 int state_file_frame(const std::string& name);
 // obsCC.obj: a static obstacle, written once.
 std::string static_obstacle_file_name(int obstacle);
+
+// The files of one saved frame of a run folder.
+struct SavedFrameFiles {
+  std::vector<std::string> cloths;     // NNNNN_CC.obj, CC = 0, 1, ... (paths)
+  std::vector<std::string> obstacles;  // per obstacle index: its file at this frame (moving) or obsCC.obj
+};
+// Saved frames of the run folder `dir`: frame number -> files. A frame is listed when its cloth 0 file exists
+// (frame files are written under a temporary name and renamed, so a listed file is whole). Used by `replay`
+// and `inspect`.
+std::map<int, SavedFrameFiles> find_saved_frames(const std::string& dir);
 
 // True for the names above and conf.json / log.jsonl: names a scene's own files must not take in the folder.
 bool is_output_file_name(const std::string& name);

@@ -42,48 +42,6 @@ namespace {
 
 const char kCommand[] = "replay";
 
-struct FrameFiles {
-  std::vector<std::string> cloths;     // NNNNN_CC.obj, CC = 0, 1, ...
-  std::vector<std::string> obstacles;  // per obstacle index: its file at this frame (moving) or obsCC.obj
-};
-
-// Saved frames of the run: frame number -> files. A frame is complete when its state file exists or, for
-// folders written before state files, when its first cloth file exists.
-std::map<int, FrameFiles> find_frames(const std::string& dir) {
-  std::map<int, FrameFiles> frames;
-  std::error_code ec;
-  std::map<int, std::string> static_obstacles;
-  std::map<int, std::map<int, std::string>> moving;  // frame -> obstacle -> file
-  std::map<int, std::map<int, std::string>> cloth_files;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    int frame = -1, index = -1;
-    char tail = 0;
-    if (std::sscanf(name.c_str(), "%d_obs%d.ob%c", &frame, &index, &tail) == 3 && tail == 'j')
-      moving[frame][index] = entry.path().string();
-    else if (std::sscanf(name.c_str(), "obs%d.ob%c", &index, &tail) == 2 && tail == 'j')
-      static_obstacles[index] = entry.path().string();
-    else if (std::sscanf(name.c_str(), "%d_%d.ob%c", &frame, &index, &tail) == 3 && tail == 'j' &&
-             name == cloth_frame_file_name(frame, index))
-      cloth_files[frame][index] = entry.path().string();
-  }
-  int obstacle_count = 0;
-  for (const auto& [i, f] : static_obstacles) obstacle_count = std::max(obstacle_count, i + 1);
-  for (const auto& [frame, files] : moving)
-    for (const auto& [i, f] : files) obstacle_count = std::max(obstacle_count, i + 1);
-  for (const auto& [frame, files] : cloth_files) {
-    FrameFiles ff;
-    for (int c = 0; files.count(c); ++c) ff.cloths.push_back(files.at(c));
-    if (ff.cloths.empty()) continue;
-    for (int i = 0; i < obstacle_count; ++i) {
-      if (moving.count(frame) && moving[frame].count(i)) ff.obstacles.push_back(moving[frame][i]);
-      else if (static_obstacles.count(i)) ff.obstacles.push_back(static_obstacles[i]);
-    }
-    frames[frame] = ff;
-  }
-  return frames;
-}
-
 RenderMesh load_render_mesh(const std::string& path, bool highlight_boundary) {
   const ObjData obj = read_obj(path);
   std::vector<std::array<int, 3>> tris;
@@ -98,18 +56,6 @@ void parse_size(const std::string& text, int& width, int& height) {
   if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &extra) != 3 || (x != 'x' && x != 'X') ||
       width < 16 || height < 16 || width > 16384 || height > 16384)
     throw InputError(std::string(kCommand) + ": --size: expected WxH with 16 <= W, H <= 16384, got '" + text + "'");
-}
-
-void parse_range(const std::string& text, int& first, int& last) {
-  const size_t colon = text.find(':');
-  if (colon == std::string::npos) {
-    first = last = integer_argument(kCommand, "--frames", text, 0, 1000000000);
-    return;
-  }
-  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-  if (!a.empty()) first = integer_argument(kCommand, "--frames", a, 0, 1000000000);
-  if (!b.empty()) last = integer_argument(kCommand, "--frames", b, 0, 1000000000);
-  if (first > last) throw InputError(std::string(kCommand) + ": --frames: empty range '" + text + "'");
 }
 
 }  // namespace
@@ -127,7 +73,7 @@ int run_replay_command(const std::vector<std::string>& args, const Console& cons
   std::string video;
   for (const auto& [name, value] : parsed.options) {
     if (name == "--size") parse_size(value, width, height);
-    else if (name == "--frames") parse_range(value, first, last);
+    else if (name == "--frames") frame_range_argument(kCommand, value, first, last);
     else if (name == "--every") every = integer_argument(kCommand, name, value, 1, 1000000);
     else if (name == "--wire") wire = true;
     else if (name == "--video") video = value;
@@ -142,8 +88,8 @@ int run_replay_command(const std::vector<std::string>& args, const Console& cons
   if (!fs::is_directory(dir, ec)) throw InputError(dir + ": no such output folder");
 
   // Frames to draw.
-  const std::map<int, FrameFiles> all = find_frames(dir);
-  std::vector<std::pair<int, FrameFiles>> frames;
+  const std::map<int, SavedFrameFiles> all = find_saved_frames(dir);
+  std::vector<std::pair<int, SavedFrameFiles>> frames;
   int index = 0;
   for (const auto& [frame, files] : all) {
     if (frame < first || frame > last) continue;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "math/disjoint_sets.hpp"
 #include "math/errors.hpp"
 
 namespace arcsim {
@@ -20,23 +21,6 @@ bool rest_triangle_degenerate(const Vec3& u0, const Vec3& u1, const Vec3& u2) {
 }
 
 namespace {
-
-// Minimal union-find over 0..n-1 with path halving.
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int find(int x) {
-    while (parent_[x] != x) {
-      parent_[x] = parent_[parent_[x]];
-      x = parent_[x];
-    }
-    return x;
-  }
-  void unite(int a, int b) { parent_[find(a)] = find(b); }
-
- private:
-  std::vector<int> parent_;
-};
 
 // ----------------------------------------------------------------------------------------------------------
 // validate_triangles

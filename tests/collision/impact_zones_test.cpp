@@ -9,7 +9,7 @@
 #include "collision/collision_step.hpp"
 #include "collision/impact_zones.hpp"
 #include "collision/proximity.hpp"
-#include "collision/tri_tri.hpp"
+#include "collision/triangle_intersection.hpp"
 #include "support/mesh_factory.hpp"
 
 namespace arcsim {
@@ -45,7 +45,7 @@ int intersections(const ContactGeometry& g, int mesh_a, int mesh_b) {
     for (int h = rb.face_begin; h < rb.face_end; ++h) {
       std::array<Vec3, 3> s, t;
       for (int i = 0; i < 3; ++i) s[i] = g.x1[g.faces[f][i]], t[i] = g.x1[g.faces[h][i]];
-      n += testing::triangles_intersect(s, t);
+      n += triangles_intersect(s, t);
     }
   return n;
 }

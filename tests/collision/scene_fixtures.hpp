@@ -11,7 +11,8 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/tri_tri.hpp"
+#include "collision/intersections.hpp"
+#include "collision/triangle_intersection.hpp"
 #include "io/obj.hpp"
 #include "sim/simulation.hpp"
 #include "support/files.hpp"
@@ -113,41 +114,13 @@ inline std::array<Vec3, 3> world_triangle(const Mesh& m, int f) {
 }
 
 // Intersecting pairs of triangles: within each cloth (pairs sharing no node), between cloths, and between
-// cloths and obstacles. Box prefilter, then the exact test.
+// cloths and active obstacles (collision/intersections.hpp: exact, through bounding-volume hierarchies).
 inline int count_intersecting_pairs(const Simulation& sim) {
-  auto box = [](const std::array<Vec3, 3>& t) {
-    Eigen::AlignedBox3d b;
-    for (const Vec3& p : t) b.extend(p);
-    return b;
-  };
-  auto shares_node = [](const Mesh& m, int f, int g) {
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (m.face_node(f, i) == m.face_node(g, j)) return true;
-    return false;
-  };
-  auto count = [&](const Mesh& a, const Mesh& b, bool same) {
-    int n = 0;
-    for (int f = 0; f < static_cast<int>(a.faces.size()); ++f) {
-      const auto tf = world_triangle(a, f);
-      const auto bf = box(tf);
-      for (int g = same ? f + 1 : 0; g < static_cast<int>(b.faces.size()); ++g) {
-        if (same && shares_node(a, f, g)) continue;
-        const auto tg = world_triangle(b, g);
-        if (!bf.intersects(box(tg))) continue;
-        n += triangles_intersect(tf, tg);
-      }
-    }
-    return n;
-  };
-  int total = 0;
-  for (size_t i = 0; i < sim.cloths.size(); ++i) {
-    total += count(sim.cloths[i].mesh, sim.cloths[i].mesh, true);
-    for (size_t j = i + 1; j < sim.cloths.size(); ++j) total += count(sim.cloths[i].mesh, sim.cloths[j].mesh, false);
-    for (const Obstacle& o : sim.obstacles)
-      if (o.active) total += count(sim.cloths[i].mesh, o.mesh, false);
-  }
-  return total;
+  std::vector<const Mesh*> sheets, obstacles;
+  for (const Cloth& c : sim.cloths) sheets.push_back(&c.mesh);
+  for (const Obstacle& o : sim.obstacles)
+    if (o.active) obstacles.push_back(&o.mesh);
+  return static_cast<int>(intersecting_pairs(sheets, obstacles).size());
 }
 
 inline double lowest_cloth_y(const Simulation& sim) {

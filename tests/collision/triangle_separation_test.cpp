@@ -6,7 +6,7 @@
 #include <random>
 
 #include "collision/distance.hpp"
-#include "collision/tri_tri.hpp"
+#include "collision/triangle_intersection.hpp"
 
 namespace arcsim {
 namespace {
@@ -43,7 +43,7 @@ TEST(TriangleSeparation, ZeroExactlyWhenCrossingElseTheDistance) {
   for (int trial = 0; trial < 2000; ++trial) {
     const std::array<Vec3, 3> a = random_triangle(0.7), b = random_triangle(0.7);
     const double d = triangle_separation(a, b);
-    if (testing::triangles_intersect(a, b)) {
+    if (triangles_intersect(a, b)) {
       ++crossing;
       EXPECT_EQ(d, 0) << "trial " << trial;
     } else {

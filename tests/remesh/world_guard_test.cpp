@@ -5,7 +5,7 @@
 // without it the same pass crosses it or leaves it outside (so the test can tell).
 #include <gtest/gtest.h>
 
-#include "collision/tri_tri.hpp"
+#include "collision/triangle_intersection.hpp"
 #include "mesh/validate.hpp"
 #include "remesh/remesh.hpp"
 #include "remesh/remesh_fixtures.hpp"
@@ -63,7 +63,7 @@ int crossings(const Mesh& sheet, const Mesh& obstacle) {
       a[i] = sheet.nodes[sheet.face_node(static_cast<int>(f), i)].x;
       b[i] = obstacle.nodes[obstacle.face_node(0, i)].x;
     }
-    n += testing::triangles_intersect(a, b);
+    n += triangles_intersect(a, b);
   }
   return n;
 }

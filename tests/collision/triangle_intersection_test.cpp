@@ -1,16 +1,16 @@
-// The exact triangle-triangle intersection test used by the collision tests.
+// The exact triangle-triangle intersection test (collision/triangle_intersection.hpp).
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "collision/tri_tri.hpp"
+#include "collision/triangle_intersection.hpp"
 
 namespace arcsim::testing {
 namespace {
 
 using Tri = std::array<Vec3, 3>;
 
-TEST(TriTri, Orient3dSignsIncludingNearDegenerate) {
+TEST(TriangleIntersection, Orient3dSignsIncludingNearDegenerate) {
   const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
   EXPECT_EQ(orient3d(a, b, c, Vec3(0.2, 0.2, -1)), 1);
   EXPECT_EQ(orient3d(a, b, c, Vec3(0.2, 0.2, 1)), -1);
@@ -22,7 +22,7 @@ TEST(TriTri, Orient3dSignsIncludingNearDegenerate) {
   EXPECT_EQ(orient3d(o + a, o + b, o + c, Vec3(1e6 + 0.3, 1e6 + 0.3, std::nextafter(1e6, 0.0))), 1);
 }
 
-TEST(TriTri, BasicConfigurations) {
+TEST(TriangleIntersection, BasicConfigurations) {
   const Tri t{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
   // Piercing, separated, touching at a vertex, coplanar overlapping, coplanar disjoint.
   EXPECT_TRUE(triangles_intersect(t, {Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(2, 2, 0.5)}));
@@ -38,7 +38,7 @@ TEST(TriTri, BasicConfigurations) {
   EXPECT_FALSE(triangles_intersect(t, {Vec3(0.1, 0.1, 1e-12), Vec3(2, 0.1, 1e-12), Vec3(0.1, 2, 1e-12)}));
 }
 
-TEST(TriTri, AgreesWithSegmentSamplingOnRandomPairs) {
+TEST(TriangleIntersection, AgreesWithSegmentSamplingOnRandomPairs) {
   // Independent check: sample points of each triangle's edges against the other's closed triangle via
   // barycentric solves; only clear cases (well separated or deeply crossing) are compared.
   std::mt19937 rng(8);

@@ -1,34 +1,30 @@
-// Exact triangle-triangle intersection for tests: orientation predicates evaluated in floating point with an
-// error bound, and exactly (expansion arithmetic: sums and products of doubles kept as unevaluated sums of
-// non-overlapping doubles) when the bound cannot decide the sign. Touching counts as intersecting.
-#pragma once
+#include "collision/triangle_intersection.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
-#include "math/types.hpp"
+namespace arcsim {
 
-namespace arcsim::testing {
 
+namespace {
 namespace exact {
 
 // a + b = x + y exactly.
-inline void two_sum(double a, double b, double& x, double& y) {
+void two_sum(double a, double b, double& x, double& y) {
   x = a + b;
   const double bv = x - a, av = x - bv;
   y = (a - av) + (b - bv);
 }
 
 // a * b = x + y exactly (fused multiply-add gives the rounding error).
-inline void two_product(double a, double b, double& x, double& y) {
+void two_product(double a, double b, double& x, double& y) {
   x = a * b;
   y = std::fma(a, b, -x);
 }
 
 // e + b for a non-overlapping expansion e (components by increasing magnitude); keeps the invariant.
-inline void grow(std::vector<double>& e, double b) {
+void grow(std::vector<double>& e, double b) {
   double q = b;
   std::vector<double> out;
   out.reserve(e.size() + 1);
@@ -43,17 +39,17 @@ inline void grow(std::vector<double>& e, double b) {
 }
 
 // Sign of the expansion: that of its largest component.
-inline int sign(const std::vector<double>& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
+int sign(const std::vector<double>& e) { return e.empty() ? 0 : (e.back() > 0 ? 1 : -1); }
 
 // The exact difference a - b as two doubles.
-inline std::array<double, 2> diff(double a, double b) {
+std::array<double, 2> diff(double a, double b) {
   double x, y;
   two_sum(a, -b, x, y);
   return {x, y};
 }
 
 // Adds s * a * b * c exactly to e (a, b, c each an exact two-double value).
-inline void add_triple(std::vector<double>& e, int s, const std::array<double, 2>& a, const std::array<double, 2>& b,
+void add_triple(std::vector<double>& e, int s, const std::array<double, 2>& a, const std::array<double, 2>& b,
                        const std::array<double, 2>& c) {
   for (double ai : a)
     for (double bj : b)
@@ -70,9 +66,10 @@ inline void add_triple(std::vector<double>& e, int s, const std::array<double, 2
 }
 
 }  // namespace exact
+}  // namespace
 
 // Sign of det[a - d, b - d, c - d]: positive when d lies below the plane of (a, b, c) seen counter-clockwise.
-inline int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const Vec3 u = a - d, v = b - d, w = c - d;
   const double det = u.dot(v.cross(w));
   const double permanent = std::abs(u.x()) * (std::abs(v.y() * w.z()) + std::abs(v.z() * w.y())) +
@@ -98,7 +95,7 @@ inline int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) 
 }
 
 // Sign of the 2D orientation of (a, b, c) in the coordinate plane that drops axis `drop`.
-inline int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
+int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
   const int i = (drop + 1) % 3, j = (drop + 2) % 3;
   const double l = (a[i] - c[i]) * (b[j] - c[j]), r = (a[j] - c[j]) * (b[i] - c[i]);
   const double det = l - r;
@@ -110,10 +107,10 @@ inline int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
   return exact::sign(e);
 }
 
-namespace detail {
+namespace {
 
 // Closed segments pq and rs in the plane dropping axis `drop` intersect.
-inline bool segments_intersect_2d(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s, int drop) {
+bool segments_intersect_2d(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s, int drop) {
   const int o1 = orient2d(p, q, r, drop), o2 = orient2d(p, q, s, drop);
   const int o3 = orient2d(r, s, p, drop), o4 = orient2d(r, s, q, drop);
   if (o1 * o2 < 0 && o3 * o4 < 0) return true;
@@ -126,12 +123,12 @@ inline bool segments_intersect_2d(const Vec3& p, const Vec3& q, const Vec3& r, c
          (o3 == 0 && on_segment(r, s, p)) || (o4 == 0 && on_segment(r, s, q));
 }
 
-inline bool point_in_triangle_2d(const Vec3& p, const std::array<Vec3, 3>& t, int drop) {
+bool point_in_triangle_2d(const Vec3& p, const std::array<Vec3, 3>& t, int drop) {
   const int a = orient2d(t[0], t[1], p, drop), b = orient2d(t[1], t[2], p, drop), c = orient2d(t[2], t[0], p, drop);
   return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
 }
 
-inline bool coplanar_triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t) {
+bool coplanar_triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t) {
   const Vec3 n = (s[1] - s[0]).cross(s[2] - s[0]);
   Eigen::Index drop;
   n.cwiseAbs().maxCoeff(&drop);
@@ -142,17 +139,17 @@ inline bool coplanar_triangles_intersect(const std::array<Vec3, 3>& s, const std
 }
 
 // Segment pq meets triangle t (not coplanar with it).
-inline bool segment_meets_triangle(const Vec3& p, const Vec3& q, const std::array<Vec3, 3>& t) {
+bool segment_meets_triangle(const Vec3& p, const Vec3& q, const std::array<Vec3, 3>& t) {
   const int op = orient3d(t[0], t[1], t[2], p), oq = orient3d(t[0], t[1], t[2], q);
   if (op * oq > 0 || (op == 0 && oq == 0)) return false;
   const int a = orient3d(p, q, t[0], t[1]), b = orient3d(p, q, t[1], t[2]), c = orient3d(p, q, t[2], t[0]);
   return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
 }
 
-}  // namespace detail
+}  // namespace
 
 // Closed triangles s and t share at least one point.
-inline bool triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t) {
+bool triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t) {
   // Quick rejection: every corner of one strictly on one side of the other's plane.
   int side_t[3], side_s[3];
   for (int k = 0; k < 3; ++k) side_t[k] = orient3d(s[0], s[1], s[2], t[k]);
@@ -161,13 +158,13 @@ inline bool triangles_intersect(const std::array<Vec3, 3>& s, const std::array<V
   for (int k = 0; k < 3; ++k) side_s[k] = orient3d(t[0], t[1], t[2], s[k]);
   if ((side_s[0] > 0 && side_s[1] > 0 && side_s[2] > 0) || (side_s[0] < 0 && side_s[1] < 0 && side_s[2] < 0))
     return false;
-  if (side_t[0] == 0 && side_t[1] == 0 && side_t[2] == 0) return detail::coplanar_triangles_intersect(s, t);
+  if (side_t[0] == 0 && side_t[1] == 0 && side_t[2] == 0) return coplanar_triangles_intersect(s, t);
   // Not coplanar: the intersection, if any, is a segment whose ends lie on edges of s or t.
   for (int k = 0; k < 3; ++k) {
-    if (detail::segment_meets_triangle(s[k], s[(k + 1) % 3], t)) return true;
-    if (detail::segment_meets_triangle(t[k], t[(k + 1) % 3], s)) return true;
+    if (segment_meets_triangle(s[k], s[(k + 1) % 3], t)) return true;
+    if (segment_meets_triangle(t[k], t[(k + 1) % 3], s)) return true;
   }
   return false;
 }
 
-}  // namespace arcsim::testing
+}  // namespace arcsim
