@@ -27,7 +27,7 @@ BENCH_SRC := $(shell find tools/bench -name '*.cpp' 2>/dev/null | sort)
 
 obj = $(patsubst %.cpp,build/$(1)/%.o,$(2))
 
-.PHONY: all deps check check-release check-asan demo bench clean slowcheck fuzz
+.PHONY: all deps check check-release check-asan demo bench clean slowcheck fuzz report
 
 all: bin/arcsim
 
@@ -150,6 +150,13 @@ demo: deps
 	./bin/arcsim simulate conf/demo.json out/demo
 	./bin/arcsim replay out/demo out/demo/png
 	@echo "demo: frames in out/demo/, rendered PNGs in out/demo/png/"
+
+# The paper's scenes, each run to its end and checked frame by frame, with a Table 1 of ours, contact sheets
+# (docs/img/) and the plots of speed against error, written into docs/benchmarks.md (tools/report.py,
+# tools/speed_vs_error.py). ARCSIM=/path/to/arcsim adds ARCSim 0.3.1's fracture scenes side by side.
+report: deps
+	@$(MAKE) --no-print-directory bin/arcsim
+	./tools/report.py --update-benchmarks docs/benchmarks.md $(if $(ARCSIM),--arcsim $(ARCSIM))
 
 bench: deps
 	@$(MAKE) --no-print-directory bin/arcsim-bench
