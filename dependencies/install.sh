@@ -17,7 +17,8 @@ PACKAGES=(
   libbenchmark-dev         # benchmarks
   libomp-dev               # OpenMP runtime (clang's libomp for the fuzz build; g++ ships libgomp)
   clang libclang-rt-14-dev # libFuzzer and the sanitizers for `make fuzz` (fuzz/)
-  python3-matplotlib python3-pil  # `make report`: plots of speed against error, contact sheets of frames
+  python3-matplotlib python3-pil python3-scipy  # tools/: plots of speed against error, contact sheets of frames,
+                           # nearest-node distances between runs (compare_builds.py)
 )
 
 missing=()
