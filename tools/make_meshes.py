@@ -8,6 +8,14 @@ meshes/strip.obj        1 m x 0.1 m, 20 x 2 cells, 63 nodes, 80 faces; left end 
 meshes/square_notch.obj the square with a 90-degree V notch (0.1 m deep, 0.2 m wide) cut into the middle of the
                         left side, tip at (0.1, 0.5); 120 nodes, 198 faces; bottom side label 1, top side label 2
                         (for pulling the sheet apart across the notch).
+meshes/square_slit.obj  1 m x 1 m, 20 x 20 cells, a slit 0.2 deep into the middle of the left side (a thin V, 0.02
+                        wide at the edge, tip at (0.2, 0.5)); 445 nodes, 800 faces; bottom side label 1, top side
+                        label 2 (rubber tearing, conf/paper-rubber-tear.json).
+meshes/square_top_slit.obj  the same turned a quarter turn: the slit runs down from the middle of the top side
+                        (tip at (0.5, 0.8)); grips along the top two rows left (x in [0.25, 0.4], label 1) and
+                        right (x in [0.6, 0.75], label 2) of it (paper tearing, conf/paper-tearing.json).
+meshes/square_clamped.obj  the square (10 x 10 cells, 121 nodes, 200 faces) with its 40 border nodes labelled 1
+                        (clamped all round: conf/paper-variety.json).
 meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
 meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
                         320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
@@ -91,6 +99,69 @@ def square_notch():
     return drop_node(nodes, faces, labels, cut_node)
 
 
+def slit_sheet(cells, slit_cells, half_width):
+    """A unit square of cells x cells grid cells with a slit cut into the middle of its left side: the nodes of the
+    middle row (j = cells / 2) left of column slit_cells are doubled, the copy used by the faces above the slit
+    moved up and the other moved down by half_width * (1 - x / depth), so the slit is a thin V (opening
+    2 half_width at the edge) whose tip is the single node (slit_cells / cells, 0.5). Returns nodes, faces,
+    node(i, j) and top(i) (the node above the slit in column i, the copy for i < slit_cells)."""
+    nodes, faces, node = grid(1.0, 1.0, cells, cells)
+    mid = cells // 2
+    depth = slit_cells / cells
+    nodes = list(nodes)
+    copy = {}
+    for i in range(slit_cells):
+        x, y = nodes[node(i, mid)]
+        w = half_width * (1 - x / depth)
+        nodes[node(i, mid)] = (x, y - w)
+        copy[node(i, mid)] = len(nodes)
+        nodes.append((x, y + w))
+    # a face lies above the slit when its centroid does
+    split = []
+    for f in faces:
+        if sum(nodes[n][1] for n in f) / 3 > 0.5 and any(n in copy for n in f):
+            f = tuple(copy.get(n, n) for n in f)
+        split.append(f)
+    top = lambda i: copy.get(node(i, mid), node(i, mid))
+    return nodes, split, node, top
+
+
+def square_slit():
+    """meshes/square_slit.obj: 20 x 20 cells, a slit 0.2 deep (4 cells) into the middle of the left side, 0.02
+    wide at the edge; bottom side label 1, top side label 2 (pulled apart across the slit: rubber tearing)."""
+    nodes, faces, node, _ = slit_sheet(20, 4, 0.01)
+    labels = {}
+    for i in range(21):
+        labels[node(i, 0)] = 1
+        labels[node(i, 20)] = 2
+    return nodes, faces, labels
+
+
+def square_top_slit():
+    """meshes/square_top_slit.obj: the slit sheet turned a quarter turn clockwise, so the slit (0.2 deep, 0.02
+    wide at the edge) runs down from the middle of the top side, tip at (0.5, 0.8). Label 1: the nodes of the
+    top two rows with x in [0.25, 0.4] (a grip left of the slit), label 2: x in [0.6, 0.75] (a grip right of it);
+    paper tearing by hand."""
+    nodes, faces, node, _ = slit_sheet(20, 4, 0.01)
+    nodes = [(y, 1 - x) for x, y in nodes]   # rotation by -90 degrees plus a shift: keeps the faces CCW
+    labels = {}
+    for n, (x, y) in enumerate(nodes):
+        if y > 0.899:
+            if 0.249 < x < 0.401:
+                labels[n] = 1
+            elif 0.599 < x < 0.751:
+                labels[n] = 2
+    return nodes, faces, labels
+
+
+def square_clamped():
+    """meshes/square_clamped.obj: the 10 x 10 square with every border node labelled 1 (a sheet clamped all round:
+    the material-variety impacts, conf/paper-variety.json)."""
+    nodes, faces, node = grid(1.0, 1.0, 10, 10)
+    labels = {node(i, j): 1 for j in range(11) for i in range(11) if i in (0, 10) or j in (0, 10)}
+    return nodes, faces, labels
+
+
 def ground():
     nodes, faces, _ = grid(1.0, 1.0, 1, 1)
     return nodes, faces, {}
@@ -149,6 +220,14 @@ def main():
     write_obj(os.path.join(out_dir, "square_notch.obj"),
               "1 m x 1 m sheet with a V notch (tip at 0.1 0.5) in the left side; bottom label 1, top label 2\n" +
               generated, *square_notch())
+    write_obj(os.path.join(out_dir, "square_slit.obj"),
+              "1 m x 1 m sheet, 20 x 20 cells, with a slit 0.2 deep (tip at 0.2 0.5) into its left side; bottom "
+              "label 1, top label 2\n" + generated, *square_slit())
+    write_obj(os.path.join(out_dir, "square_top_slit.obj"),
+              "1 m x 1 m sheet, 20 x 20 cells, with a slit 0.2 deep (tip at 0.5 0.8) down from its top side; grips "
+              "left (label 1) and right (label 2) of it along the top\n" + generated, *square_top_slit())
+    write_obj(os.path.join(out_dir, "square_clamped.obj"),
+              "1 m x 1 m flat sheet, 10 x 10 cells; every border node label 1\n" + generated, *square_clamped())
     write_obj(os.path.join(out_dir, "ground.obj"),
               "1 m x 1 m flat sheet, one cell (a floor obstacle)\n" + generated, *ground())
     write_obj_3d(os.path.join(out_dir, "sphere.obj"),
