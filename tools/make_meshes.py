@@ -220,7 +220,7 @@ def write_obj_3d_labelled(path, comment, nodes, faces, labels):
 
 # Frequencies of the geodesic ornament meshes written by main(): 6 is the adaptive run's coarse start; the
 # others are static meshes of 20 f^2 faces to match an adaptive run's mean face count (conf/paper-ornament*.json).
-ORNAMENT_FREQUENCIES = (6, 12, 16, 20)
+ORNAMENT_FREQUENCIES = (6, 12, 14, 16, 20)
 
 
 def main():
