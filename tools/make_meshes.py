@@ -11,6 +11,12 @@ meshes/square_notch.obj the square with a 90-degree V notch (0.1 m deep, 0.2 m w
 meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
 meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
                         320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
+meshes/geosphereF.obj   unit geodesic sphere (icosahedron faces cut F x F), 20 F^2 faces, F in
+                        ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 16, 20: static meshes to
+                        match an adaptive run's mean face count, conf/paper-ornament*.json).
+meshes/hemisphere.obj   unit hemisphere z >= 0 (octahedron's upper faces cut 8 x 8), 256 faces; rim label 1
+                        (conf/paper-dome.json).
+meshes/pane.obj         1 m x 1 m, 16 x 16 cells, 512 faces; every border node label 1 (conf/paper-window.json).
 No `vt` lines: a flat sheet's rest shape is its initial world shape. Coordinates are in metres.
 """
 import os
