@@ -19,6 +19,12 @@ meshes/square_clamped.obj  the square (10 x 10 cells, 121 nodes, 200 faces) with
 meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
 meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
                         320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
+meshes/geosphereF.obj   unit geodesic sphere (icosahedron faces cut F x F), 20 F^2 faces, F in
+                        ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 16, 20: static meshes to
+                        match an adaptive run's mean face count, conf/paper-ornament*.json).
+meshes/hemisphere.obj   unit hemisphere z >= 0 (octahedron's upper faces cut 8 x 8), 256 faces; rim label 1
+                        (conf/paper-dome.json).
+meshes/pane.obj         1 m x 1 m, 16 x 16 cells, 512 faces; every border node label 1 (conf/paper-window.json).
 No `vt` lines: a flat sheet's rest shape is its initial world shape. Coordinates are in metres.
 """
 import os
@@ -208,6 +214,92 @@ def write_obj_3d(path, comment, nodes, faces):
         out.write("\n".join(lines) + "\n")
 
 
+# --- glass scenes (paper Fig. 9 right, 10, 11 left) ---------------------------------------------------------
+
+def geodesic_sphere(frequency):
+    """Unit sphere from the icosahedron with each face cut into frequency^2 triangles (class I geodesic grid,
+    edges split into `frequency` parts, nodes pushed onto the sphere): 20 f^2 faces, 10 f^2 + 2 nodes. Unlike
+    icosphere(), any frequency, so a static mesh can be matched to a face count. Outward CCW faces."""
+    g = (1 + 5 ** 0.5) / 2
+    corners = [(-1, g, 0), (1, g, 0), (-1, -g, 0), (1, -g, 0), (0, -1, g), (0, 1, g), (0, -1, -g), (0, 1, -g),
+               (g, 0, -1), (g, 0, 1), (-g, 0, -1), (-g, 0, 1)]
+    ico = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+           (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+           (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    return subdivided_polyhedron(corners, ico, frequency)
+
+
+def subdivided_polyhedron(corners, triangles, frequency):
+    """Each triangle (a, b, c) of a polyhedron cut into frequency^2 triangles on the barycentric grid
+    a + (i (b - a) + j (c - a)) / f, nodes shared along edges and corners (keyed by their exact rational
+    barycentric position), then every node pushed onto the unit sphere."""
+    f = frequency
+    nodes, index = [], {}
+
+    def node(a, b, c, i, j):
+        # The grid point's weights over the corners, as integers out of f: unique for a shared point.
+        weights = {}
+        for corner, w in ((a, f - i - j), (b, i), (c, j)):
+            if w:
+                weights[corner] = weights.get(corner, 0) + w
+        key = tuple(sorted(weights.items()))
+        if key not in index:
+            p = [sum(corners[k][d] * w for k, w in key) / f for d in range(3)]
+            length = sum(x * x for x in p) ** 0.5
+            nodes.append(tuple(x / length for x in p))
+            index[key] = len(nodes) - 1
+        return index[key]
+
+    faces = []
+    for a, b, c in triangles:
+        for j in range(f):
+            for i in range(f - j):
+                p, q, r = node(a, b, c, i, j), node(a, b, c, i + 1, j), node(a, b, c, i, j + 1)
+                faces.append((p, q, r))
+                if i + j + 1 < f:
+                    faces.append((q, node(a, b, c, i + 1, j + 1), r))
+    return nodes, faces
+
+
+def hemisphere(frequency):
+    """Unit upper hemisphere (z >= 0) from the octahedron's four upper faces, each cut into frequency^2
+    triangles and pushed onto the sphere: 4 f^2 faces; its rim is the octahedron's equator, so it lies exactly
+    in the plane z = 0. Rim nodes carry label 1 (the held rim of the glass dome). Outward CCW faces."""
+    corners = [(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (0, 0, 1)]
+    upper = [(0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)]
+    nodes, faces = subdivided_polyhedron(corners, upper, frequency)
+    labels = {n: 1 for n, p in enumerate(nodes) if abs(p[2]) < 1e-12}
+    return nodes, faces, labels
+
+
+def pane(cells):
+    """1 m x 1 m flat sheet, cells x cells, with every border node labelled 1 (a window pane held in its
+    frame). Chequerboard diagonals as grid()."""
+    nodes, faces, node = grid(1.0, 1.0, cells, cells)
+    labels = {}
+    for k in range(cells + 1):
+        for n in (node(k, 0), node(k, cells), node(0, k), node(cells, k)):
+            labels[n] = 1
+    return nodes, faces, labels
+
+
+def write_obj_3d_labelled(path, comment, nodes, faces, labels):
+    """write_obj_3d with `nl` node labels (for handles on curved meshes)."""
+    lines = ["# " + line for line in comment.splitlines()]
+    for n, p in enumerate(nodes):
+        lines.append("v %.12g %.12g %.12g" % p)
+        if n in labels:
+            lines.append("nl %d" % labels[n])
+    lines += ["f %d %d %d" % (a + 1, b + 1, c + 1) for a, b, c in faces]
+    with open(path, "w") as out:
+        out.write("\n".join(lines) + "\n")
+
+
+# Frequencies of the geodesic ornament meshes written by main(): 6 is the adaptive run's coarse start; the
+# others are static meshes of 20 f^2 faces to match an adaptive run's mean face count (conf/paper-ornament*.json).
+ORNAMENT_FREQUENCIES = (6, 12, 14, 16, 20)
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "meshes")
@@ -232,6 +324,16 @@ def main():
               "1 m x 1 m flat sheet, one cell (a floor obstacle)\n" + generated, *ground())
     write_obj_3d(os.path.join(out_dir, "sphere.obj"),
                  "unit sphere, icosahedron subdivided twice, outward faces\n" + generated, *icosphere(2))
+    for f in ORNAMENT_FREQUENCIES:
+        nodes, faces = geodesic_sphere(f)
+        write_obj_3d(os.path.join(out_dir, "geosphere%d.obj" % f),
+                     "unit geodesic sphere, icosahedron faces cut %dx%d (%d faces), outward\n" % (f, f, len(faces))
+                     + generated, nodes, faces)
+    write_obj_3d_labelled(os.path.join(out_dir, "hemisphere.obj"),
+                          "unit hemisphere z >= 0, octahedron faces cut 8x8 (256 faces); rim label 1\n" + generated,
+                          *hemisphere(8))
+    write_obj(os.path.join(out_dir, "pane.obj"),
+              "1 m x 1 m flat pane, 16 x 16 cells; border label 1\n" + generated, *pane(16))
 
 
 if __name__ == "__main__":
