@@ -24,7 +24,8 @@ time), and their seconds per simulated second side by side.
 
 Writes the table as markdown (--markdown, default DIR/report.md); with --update-benchmarks, replaces the part of
 that file between the lines `<!-- report:begin -->` and `<!-- report:end -->` with it (added at the end the
-first time). Exit code 1 when a scene fails (non-zero exit of the simulator or of inspect).
+first time). --reuse takes each scene's figures from an earlier invocation (DIR/<scene>.result.json) where
+present, so a report can be completed scene by scene. Exit code 1 when a scene fails (non-zero exit of the simulator or of inspect).
 """
 import argparse
 import datetime
@@ -149,6 +150,10 @@ def contact_sheet(binary, out, every, image):
 def run_scene(args, name):
     conf = os.path.join(ROOT, "conf", name + ".json")
     out = os.path.join(args.out, name)
+    record = out + ".result.json"
+    if args.reuse and os.path.exists(record):
+        with open(record) as f:
+            return json.load(f)
     shutil.rmtree(out, ignore_errors=True)
     cmd = [args.binary, "simulate", conf, out, "--quiet"]
     if args.threads:
@@ -172,6 +177,8 @@ def run_scene(args, name):
     except (subprocess.CalledProcessError, ImportError, OSError) as e:
         result["sheet_frames"] = None
         result["stderr"].append("contact sheet: %s" % e)
+    with open(record, "w") as f:
+        json.dump(result, f)
     return result
 
 
@@ -272,6 +279,8 @@ def main():
     p.add_argument("--update-benchmarks", default=None)
     p.add_argument("--arcsim", default=None, help="an ARCSim 0.3.1 binary: also run its fracture scenes")
     p.add_argument("--shared", default=os.path.join(ROOT, "..", "shared"))
+    p.add_argument("--reuse", action="store_true",
+                   help="take a scene's figures from an earlier invocation's DIR/<scene>.result.json if present")
     args = p.parse_args()
     args.out = os.path.abspath(args.out)
     args.img = os.path.abspath(args.img)

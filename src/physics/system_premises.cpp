@@ -72,8 +72,9 @@ std::string explain_indefinite_system(const Mesh& mesh, const std::vector<FaceEl
     stiffest_ratio = ratio;
     std::ostringstream what;
     what.precision(4);
-    what << kind << " element of nodes " << node_list(nodes) << " (rest area " << rest_area << " m^2, lightest node "
-         << lightest << " kg): dt (dt + beta) K / m = " << ratio;
+    what << kind << " element of nodes " << node_list(nodes) << " (";
+    if (rest_area >= 0) what << "rest area " << rest_area << " m^2, ";
+    what << "lightest node " << lightest << " kg): dt (dt + beta) K / m = " << ratio;
     stiffest = what.str();
   };
   // Membrane elements.
@@ -114,7 +115,12 @@ std::string explain_indefinite_system(const Mesh& mesh, const std::vector<FaceEl
           << "(smallest eigenvalue " << smallest << " N/m)";
       return why.str();
     }
-    note_stiffness("bending", el.nodes, el.damping, t.hessian.cwiseAbs().rowwise().sum().maxCoeff(), 0.0);
+    // The rest area of the element's own face, where the face list holds it at the same index (the full step's
+    // cache does; a zone's lists need not), otherwise none is printed.
+    const bool same_face = i < faces.size() && faces[i].nodes[0] == el.nodes[0] && faces[i].nodes[1] == el.nodes[1] &&
+                           faces[i].nodes[2] == el.nodes[2];
+    note_stiffness("bending", el.nodes, el.damping, t.hessian.cwiseAbs().rowwise().sum().maxCoeff(),
+                   same_face ? faces[i].area : -1.0);
   }
   // Contacts and handles.
   for (const ContactTerm& c : loads.contacts) {
