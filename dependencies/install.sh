@@ -17,7 +17,6 @@ PACKAGES=(
   libbenchmark-dev         # benchmarks
   libomp-dev               # OpenMP runtime (clang's libomp for the fuzz build; g++ ships libgomp)
   clang libclang-rt-14-dev # libFuzzer and the sanitizers for `make fuzz` (fuzz/)
-  python3-matplotlib       # plots of tools/speed_vs_error.py (docs/img/sve-*.png)
 )
 
 missing=()
