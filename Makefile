@@ -157,6 +157,7 @@ demo: deps
 report: deps
 	@$(MAKE) --no-print-directory bin/arcsim
 	./tools/report.py --update-benchmarks docs/benchmarks.md $(if $(ARCSIM),--arcsim $(ARCSIM))
+	./tools/speed_vs_error.py --arcsim-bin bin/arcsim --out docs/img --markdown docs/speed-vs-error.md
 
 bench: deps
 	@$(MAKE) --no-print-directory bin/arcsim-bench
