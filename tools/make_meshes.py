@@ -23,8 +23,23 @@ meshes/geosphereF.obj   unit geodesic sphere (icosahedron faces cut F x F), 20 F
                         ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 16, 20: static meshes to
                         match an adaptive run's mean face count, conf/paper-ornament*.json).
 meshes/hemisphere.obj   unit hemisphere z >= 0 (octahedron's upper faces cut 8 x 8), 256 faces; rim label 1
-                        (conf/paper-dome.json).
+                        (docs/repro/paper-dome-draft.json).
 meshes/pane.obj         1 m x 1 m, 16 x 16 cells, 512 faces; every border node label 1 (conf/paper-window.json).
+meshes/box_frame.obj     a square tube 20 cm wide and 20 cm high (z up, open at top and bottom, centred on the z
+                        axis, bottom at z = 0): the box frame of the metal-and-glass scene. 1 cm cells, 80 around
+                        x 20 up, 1680 nodes, 3200 faces. Its front (y = -0.1) and back (y = 0.1) walls are window
+                        frames: a 2 cm aluminium border (face material 0) around a 16 x 16 cm glass pane (`tm 1`);
+                        its two side walls (x = +-0.1) are plain aluminium. Bottom two node rows (z = 0, 0.01) label 1,
+                        top two rows label 2 (a handle on them clamps the rim's position and slope).
+                        The four corner lines and the pane outlines are edge records marked `ep` (preserved:
+                        never flipped or collapsed), so remeshing keeps the folds and the material borders.
+                        No `vt`/`ms` lines: the rest shape is this folded 3D shape.
+meshes/cylinder.obj     an open tube (polycarbonate cylinder scene): radius 5 cm, height 12 cm, axis z, bottom at
+                        z = 0; 48 around x 18 up (6.5 x 6.7 mm cells), 912 nodes, 1728 faces. Bottom rim label 1,
+                        top rim label 2. The faces of the two cell rows at each rim (1.3 cm) have `tm 1`, the
+                        end collars. The radius carries a deterministic imperfection of +-0.1 mm (0.1 h):
+                        a mode of 5 waves around x 1 half-wave up plus a 3-wave tilt, so that the buckles do
+                        not have to wait for round-off. Rest shape = this shape.
 No `vt` lines: a flat sheet's rest shape is its initial world shape. Coordinates are in metres.
 """
 import os
@@ -295,9 +310,107 @@ def write_obj_3d_labelled(path, comment, nodes, faces, labels):
         out.write("\n".join(lines) + "\n")
 
 
+def write_obj_general(path, comment, nodes, faces, labels=None, materials=None, preserved=None):
+    """Extended OBJ of a 3D sheet: `v` (and `nl` labels), `f` with an optional `tm` material index per face
+    (written only when not 0), and `e a b` + `ep` edge records for the preserved edges (node index pairs)."""
+    labels = labels or {}
+    lines = ["# " + line for line in comment.splitlines()]
+    for n, p in enumerate(nodes):
+        lines.append("v %s %s %s" % tuple(number(c) for c in p))
+        if n in labels:
+            lines.append("nl %d" % labels[n])
+    for k, (a, b, c) in enumerate(faces):
+        lines.append("f %d %d %d" % (a + 1, b + 1, c + 1))
+        if materials and materials[k] != 0:
+            lines.append("tm %d" % materials[k])
+    for a, b in sorted(preserved or ()):
+        lines += ["e %d %d" % (a + 1, b + 1), "ep"]
+    with open(path, "w") as out:
+        out.write("\n".join(lines) + "\n")
+
+
 # Frequencies of the geodesic ornament meshes written by main(): 6 is the adaptive run's coarse start; the
 # others are static meshes of 20 f^2 faces to match an adaptive run's mean face count (conf/paper-ornament*.json).
 ORNAMENT_FREQUENCIES = (6, 12, 14, 16, 20)
+def periodic_tube(cells_around, cells_up, height, place):
+    """A tube: a grid `cells_around` x `cells_up` whose last column is glued to the first. `place(s, z)` maps
+    the unrolled coordinate s in [0, 1) and the height z to a 3D point. Diagonals alternate like a chequerboard
+    (cells_around even keeps the pattern across the seam). Faces are CCW seen from outside when place() runs
+    counter-clockwise about +z."""
+    assert cells_around % 2 == 0
+    def node(i, j):
+        return j * cells_around + i % cells_around
+    nodes = [place(i / cells_around, height * j / cells_up) for j in range(cells_up + 1) for i in range(cells_around)]
+    faces, cells = [], []
+    for j in range(cells_up):
+        for i in range(cells_around):
+            a, b, c, d = node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)
+            if (i + j) % 2 == 0:
+                faces += [(a, b, c), (a, c, d)]
+            else:
+                faces += [(a, b, d), (b, c, d)]
+            cells += [(i, j), (i, j)]
+    return nodes, faces, cells, node
+
+
+def box_frame(width=0.2, height=0.2, border=0.02, cell=0.01, clamp_rows=2):
+    per_wall = int(round(width / cell))
+    around, up = 4 * per_wall, int(round(height / cell))
+    h = width / 2
+    corners = [(-h, -h), (h, -h), (h, h), (-h, h)]  # counter-clockwise about +z, wall k from corner k to k+1
+
+    def place(s, z):
+        k = min(int(s * 4 + 1e-9), 3)
+        t = s * 4 - k
+        (x0, y0), (x1, y1) = corners[k], corners[(k + 1) % 4]
+        return (x0 + t * (x1 - x0), y0 + t * (y1 - y0), z)
+
+    nodes, faces, cells, node = periodic_tube(around, up, height, place)
+    b = int(round(border / cell))
+
+    def in_pane(i, j):  # cell (i, j) lies in a glass pane: front (wall 0) or back (wall 2) wall, inside the border
+        wall, local = divmod(i, per_wall)
+        return wall in (0, 2) and b <= local < per_wall - b and b <= j < up - b
+
+    materials = [1 if in_pane(i, j) else 0 for (i, j) in cells]
+    preserved = set()
+    for j in range(up):  # the corner lines
+        for k in range(4):
+            preserved.add(tuple(sorted((node(k * per_wall, j), node(k * per_wall, j + 1)))))
+    for wall in (0, 2):  # the pane outlines
+        i0, i1 = wall * per_wall + b, wall * per_wall + per_wall - b
+        for i in range(i0, i1):
+            for j in (b, up - b):
+                preserved.add(tuple(sorted((node(i, j), node(i + 1, j)))))
+        for j in range(b, up - b):
+            for i in (i0, i1):
+                preserved.add(tuple(sorted((node(i, j), node(i, j + 1)))))
+    labels = {}
+    for i in range(around):  # two rows at each rim, so that a rim handle clamps the walls' slope too
+        for j in range(clamp_rows):
+            labels[node(i, j)] = 1
+            labels[node(i, up - j)] = 2
+    return nodes, faces, labels, materials, preserved
+
+
+def cylinder(radius=0.05, height=0.12, around=48, up=18, imperfection=1e-4, collar_rows=2):
+    import math
+
+    def place(s, z):
+        phi = 2 * math.pi * s
+        r = radius + imperfection * (0.7 * math.cos(5 * phi) * math.sin(math.pi * z / height) +
+                                     0.3 * math.cos(3 * phi + 1.0) * (z / height))
+        return (r * math.cos(phi), r * math.sin(phi), z)
+
+    nodes, faces, cells, node = periodic_tube(around, up, height, place)
+    labels = {}
+    for i in range(around):
+        labels[node(i, 0)] = 1
+        labels[node(i, up)] = 2
+    # The end collars: the faces of the two cell rows at each rim get material 1 (the scene makes it unbreakable,
+    # as a tube glued into end caps; cracks then start in the buckles, not at the clamps).
+    materials = [1 if j < collar_rows or j >= up - collar_rows else 0 for (i, j) in cells]
+    return nodes, faces, labels, materials
 
 
 def main():
@@ -334,6 +447,13 @@ def main():
                           *hemisphere(8))
     write_obj(os.path.join(out_dir, "pane.obj"),
               "1 m x 1 m flat pane, 16 x 16 cells; border label 1\n" + generated, *pane(16))
+    write_obj_general(os.path.join(out_dir, "box_frame.obj"),
+                      "square tube 0.2 x 0.2 x 0.2 m: aluminium frame (tm 0), glass panes in the front and back "
+                      "walls (tm 1);\nbottom two rows label 1, top two rows label 2; corner lines and pane outlines "
+                      "preserved (ep)\n" + generated, *box_frame())
+    write_obj_general(os.path.join(out_dir, "cylinder.obj"),
+                      "open cylinder r = 0.05 m, h = 0.12 m, with a 0.1 mm imperfection; bottom rim label 1, top "
+                      "rim label 2; the two cell rows at each rim tm 1 (collars)\n" + generated, *cylinder())
 
 
 if __name__ == "__main__":
