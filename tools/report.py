@@ -236,7 +236,8 @@ def markdown(results, arcsim_rows, args):
             r["name"], r["shows"], fmt(r["sim_time"], ".2f"), r["faces_mean"], r["faces_max"],
             fmt(r["dynamics"], ".2f"), fmt(r["geometry"], ".2f"), fmt(r["total"], ".2f"),
             "%d" % paper[0] if paper else "-", fmt(paper[3], ".1f") if paper else "-",
-            fmt(paper[3] / r["total"], ".0f") + "x" if paper and r["total"] > 0 else "-",
+            fmt(paper[3] / r["total"], ".0f" if paper[3] / r["total"] >= 10 else ".2g") + "x"
+            if paper and r["total"] > 0 else "-",
             r["cracks"], piece_text, checked))
     pictures = [r for r in results if r.get("sheet_frames")]
     if pictures:
