@@ -86,13 +86,7 @@ int run_inspect_command(const std::vector<std::string>& args, const Console& con
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(dir + ": no such output folder");
 
-  const std::map<int, SavedFrameFiles> all = find_saved_frames(dir);
-  std::vector<std::pair<int, SavedFrameFiles>> frames;
-  int index = 0;
-  for (const auto& [frame, files] : all) {
-    if (frame < first || frame > last) continue;
-    if (index++ % every == 0) frames.emplace_back(frame, files);
-  }
+  std::vector<std::pair<int, SavedFrameFiles>> frames = select_saved_frames(dir, first, last, every);
   if (only_last && !frames.empty()) frames.erase(frames.begin(), frames.end() - 1);
   if (frames.empty()) throw InputError(dir + ": no saved frames (NNNNN_CC.obj) to inspect");
 

@@ -88,4 +88,15 @@ std::map<int, SavedFrameFiles> find_saved_frames(const std::string& dir) {
   return frames;
 }
 
+std::vector<std::pair<int, SavedFrameFiles>> select_saved_frames(const std::string& dir, int first, int last,
+                                                                 int every) {
+  std::vector<std::pair<int, SavedFrameFiles>> frames;
+  int index = 0;
+  for (const auto& [frame, files] : find_saved_frames(dir)) {
+    if (frame < first || frame > last) continue;
+    if (index++ % every == 0) frames.emplace_back(frame, files);
+  }
+  return frames;
+}
+
 }  // namespace arcsim

@@ -31,6 +31,10 @@ struct SavedFrameFiles {
 // (frame files are written under a temporary name and renamed, so a listed file is whole). Used by `replay`
 // and `inspect`.
 std::map<int, SavedFrameFiles> find_saved_frames(const std::string& dir);
+// The saved frames of `dir` numbered first..last, every `every`-th of them in order (the --frames and --every
+// options of `replay` and `inspect`).
+std::vector<std::pair<int, SavedFrameFiles>> select_saved_frames(const std::string& dir, int first, int last,
+                                                                 int every);
 
 // True for the names above and conf.json / log.jsonl: names a scene's own files must not take in the folder.
 bool is_output_file_name(const std::string& name);

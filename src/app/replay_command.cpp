@@ -88,13 +88,7 @@ int run_replay_command(const std::vector<std::string>& args, const Console& cons
   if (!fs::is_directory(dir, ec)) throw InputError(dir + ": no such output folder");
 
   // Frames to draw.
-  const std::map<int, SavedFrameFiles> all = find_saved_frames(dir);
-  std::vector<std::pair<int, SavedFrameFiles>> frames;
-  int index = 0;
-  for (const auto& [frame, files] : all) {
-    if (frame < first || frame > last) continue;
-    if (index++ % every == 0) frames.emplace_back(frame, files);
-  }
+  std::vector<std::pair<int, SavedFrameFiles>> frames = select_saved_frames(dir, first, last, every);
   if (frames.empty()) throw InputError(dir + ": no saved frames (NNNNN_CC.obj) to render");
 
   // World up from the run's scene; frame time for the video.
