@@ -27,6 +27,12 @@ BENCH_SRC := $(shell find tools/bench -name '*.cpp' 2>/dev/null | sort)
 
 obj = $(patsubst %.cpp,build/$(1)/%.o,$(2))
 
+# The sub-makes of check, demo, slowcheck, report, bench and fuzz compile on every core unless the caller chose a
+# job count (`make -jN check`; `-j1` for a serial build). GNU make 4.3 shows a command-line -j in MAKEFLAGS only
+# to recipes, hence the recipe-time test.
+NPROC    := $(shell nproc 2>/dev/null || echo 2)
+PARALLEL  = $(if $(filter -j%,$(MAKEFLAGS)),,-j$(NPROC))
+
 .PHONY: all deps check check-release check-asan demo bench clean slowcheck fuzz report
 
 all: bin/arcsim
@@ -87,14 +93,14 @@ bin/arcsim-bench: $(call obj,release,$(LIB_SRC) $(BENCH_SRC) $(SUPPORT_SRC))
 TEST_ENV := ARCSIM_BIN=$(CURDIR)/bin/arcsim ARCSIM_SHARED=$(abspath $(CURDIR)/../shared)
 
 check: deps
-	@$(MAKE) --no-print-directory check-release check-asan
+	@$(MAKE) --no-print-directory $(PARALLEL) check-release check-asan
 
 # Tests named *SlowCheck* (minutes-long runs of whole ARCSim scenes) run in `make slowcheck` only.
 check-release: bin/arcsim bin/arcsim-tests
 	$(TEST_ENV) OMP_NUM_THREADS=2 ./bin/arcsim-tests --gtest_brief=1 --gtest_filter='-*SlowCheck*'
 
 slowcheck: deps
-	@$(MAKE) --no-print-directory bin/arcsim bin/arcsim-tests
+	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim bin/arcsim-tests
 	$(TEST_ENV) OMP_NUM_THREADS=2 ./bin/arcsim-tests --gtest_filter='*SlowCheck*'
 
 # Sanitizer build: the whole suite except tests marked Slow (they run above, optimised).
@@ -134,7 +140,7 @@ build/fuzz/seeds.stamp: bin/arcsim $(wildcard conf/*.json meshes/*.obj fuzz/stat
 	touch $@
 
 fuzz: deps
-	@$(MAKE) --no-print-directory $(addprefix bin/fuzz-,$(FUZZ_TARGETS)) build/fuzz/seeds.stamp
+	@$(MAKE) --no-print-directory $(PARALLEL) $(addprefix bin/fuzz-,$(FUZZ_TARGETS)) build/fuzz/seeds.stamp
 	@for t in $(FUZZ_TARGETS); do \
 	  mkdir -p build/fuzz/corpus/$$t build/fuzz/findings/$$t; \
 	  echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
@@ -146,7 +152,7 @@ fuzz: deps
 	done
 
 demo: deps
-	@$(MAKE) --no-print-directory bin/arcsim
+	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim
 	./bin/arcsim simulate conf/demo.json out/demo
 	./bin/arcsim replay out/demo out/demo/png
 	@echo "demo: frames in out/demo/, rendered PNGs in out/demo/png/"
@@ -155,12 +161,12 @@ demo: deps
 # (docs/img/) and the plots of speed against error, written into docs/benchmarks.md (tools/report.py,
 # tools/speed_vs_error.py). ARCSIM=/path/to/arcsim adds ARCSim 0.3.1's fracture scenes side by side.
 report: deps
-	@$(MAKE) --no-print-directory bin/arcsim
+	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim
 	./tools/report.py --update-benchmarks docs/benchmarks.md $(if $(ARCSIM),--arcsim $(ARCSIM))
 	./tools/speed_vs_error.py --arcsim-bin bin/arcsim --out docs/img --markdown docs/speed-vs-error.md
 
 bench: deps
-	@$(MAKE) --no-print-directory bin/arcsim-bench
+	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim-bench
 	OMP_NUM_THREADS=2 ./bin/arcsim-bench
 
 clean:
