@@ -57,7 +57,9 @@ Vec12T<T> theta_gradient(const Vec3T<T>& x0, const Vec3T<T>& x1, const Vec3T<T>&
 }  // namespace
 
 double wrap_angle(double angle) {
-  const double wrapped = std::remainder(angle, 2 * M_PI);  // in [-pi, pi]
+  // remainder(angle, 2 pi) is angle itself, exactly, for |angle| <= pi (the quotient rounds to 0): the common
+  // case (a dihedral angle and its rest angle) skips the library call.
+  const double wrapped = std::abs(angle) <= M_PI ? angle : std::remainder(angle, 2 * M_PI);  // in [-pi, pi]
   return wrapped <= -M_PI ? wrapped + 2 * M_PI : wrapped;
 }
 

@@ -119,6 +119,14 @@ MembraneTerms membrane_terms(const Vec3& x0, const Vec3& x1, const Vec3& x2, con
   return out;
 }
 
+double membrane_terms_energy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Mat2& Dm_inv, double rest_area,
+                             const MembraneStiffness& k, double stiffness_factor) {
+  const Kinematics kin = kinematics(x0, x1, x2, Dm_inv);
+  const Mat3 K = voigt_stiffness(k, stiffness_factor);
+  const Vec3 s = K * kin.g;
+  return 0.5 * rest_area * kin.g.dot(s);
+}
+
 double membrane_energy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Mat2& Dm_inv, double rest_area,
                        const MembraneStiffness& k, double stiffness_factor) {
   const Mat2 G = membrane_green_strain(x0, x1, x2, Dm_inv);

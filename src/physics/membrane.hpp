@@ -62,5 +62,8 @@ struct MembraneTerms {
 MembraneTerms membrane_terms(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Mat2& Dm_inv,
                              double rest_area, const MembraneStiffness& k, double stiffness_factor,
                              HessianKind hessian);
+// membrane_terms(...).energy bit for bit, without the gradient (line searches compare energies only).
+double membrane_terms_energy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Mat2& Dm_inv, double rest_area,
+                             const MembraneStiffness& k, double stiffness_factor);
 
 }  // namespace arcsim

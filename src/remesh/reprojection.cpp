@@ -7,16 +7,29 @@
 #include "physics/bending.hpp"
 #include "physics/face_element.hpp"
 #include "physics/membrane.hpp"
-#include "physics/plate_bending.hpp"
+#include "mesh/mesh.hpp"  // dihedral_angle
 
 namespace arcsim {
 
 namespace {
 
+// Element slots of the hinge of edge i, in dihedral_angle's order (plate_bending.hpp): corners i, i+1, i+2,
+// then wing i.
+std::array<int, 4> hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 + i}; }
+
+// A bending element as the node's solve sees it. The hinges that do not contain the node keep their angle
+// while it moves: their deviations are computed once (WHY: the solve evaluates its ~12 bending elements up to
+// ~170 times per node, and a third of their hinges never change).
+struct NodeBending {
+  BendingElement el;
+  std::array<bool, 3> moves{};   // hinge i has a wing and contains the node
+  Vec3 fixed_delta = Vec3::Zero();  // wrapped angle deviations of the hinges that do not move (0 without a wing)
+};
+
 // The node's elements, built as the physics builds them (physics/face_element.hpp).
 struct Elements {
   std::vector<FaceElement> membrane;
-  std::vector<BendingElement> bending;
+  std::vector<NodeBending> bending;
   double mass = 0;  // kg
 };
 
@@ -26,60 +39,92 @@ Elements gather_elements(const Mesh& mesh, const std::vector<Material>& material
     els.membrane.push_back(make_face_element(mesh, materials, f));
     els.mass += face_corner_mass(mesh.faces[f], materials[mesh.faces[f].material]);
   }
-  for (int f : bending_faces_of_node(mesh, node)) els.bending.push_back(make_bending_element(mesh, materials, f));
-  return els;
-}
-
-// The node's share of a bending element's Gauss-Newton Hessian, 2 sum_ij Q_ij a_i a_j^T with a_i the
-// derivative of edge i's dihedral angle with respect to the node (the same approximation as
-// plate_bending_terms' kProjected, without forming the 18 x 18 matrix).
-Mat3 bending_hessian_block(const BendingElement& b, const std::array<Vec3, 6>& xs, int node) {
-  std::array<Vec3, 3> a;
-  for (int i = 0; i < 3; ++i) {
-    a[i].setZero();
-    if (!b.has_wing[i]) continue;
-    // Hinge of edge i in dihedral_angle's order: corners i, i+1, i+2, then wing i.
-    const std::array<int, 4> slots{i, (i + 1) % 3, (i + 2) % 3, 3 + i};
-    bool touches = false;
-    for (int s : slots) touches = touches || b.nodes[s] == node;
-    if (!touches) continue;
-    const Vec12 g = dihedral_angle_gradient(xs[slots[0]], xs[slots[1]], xs[slots[2]], xs[slots[3]]);
-    for (int k = 0; k < 4; ++k)
-      if (b.nodes[slots[k]] == node) a[i] += g.segment<3>(3 * k);
+  for (int f : bending_faces_of_node(mesh, node)) {
+    NodeBending b;
+    b.el = make_bending_element(mesh, materials, f);
+    for (int i = 0; i < 3; ++i) {
+      if (!b.el.has_wing[i]) continue;
+      const auto s = hinge_slots(i);
+      for (int k : s) b.moves[i] = b.moves[i] || b.el.nodes[k] == node;
+      if (!b.moves[i]) {
+        const Vec3 &x0 = mesh.nodes[b.el.nodes[s[0]]].x, &x1 = mesh.nodes[b.el.nodes[s[1]]].x,
+                   &x2 = mesh.nodes[b.el.nodes[s[2]]].x, &x3 = mesh.nodes[b.el.nodes[s[3]]].x;
+        b.fixed_delta[i] = wrap_angle(dihedral_angle(x0, x1, x2, x3) - b.el.rest_theta[i]);
+      }
+    }
+    els.bending.push_back(b);
   }
-  Mat3 H = Mat3::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (b.Q(i, j) != 0) H += 2 * b.Q(i, j) * a[i] * a[j].transpose();
-  return H;
+  return els;
 }
 
 // The load's potential is measured from `origin` (any fixed point): a constant offset, chosen so that the
 // line search compares energies of similar size instead of differences lost in the rounding of load . x.
+//
+// The energy and the node's gradient are plate_bending_terms' and membrane_terms', summed in their order, bit
+// for bit (the node's slots of the element gradients accumulate hinge by hinge, as plate_bending_terms adds
+// them); only what the node's rows need is computed. The Hessian is the node's share of the Gauss-Newton
+// Hessian, 2 sum_ij Q_ij a_i a_j^T with a_i the derivative of edge i's dihedral angle with respect to the node
+// (plate_bending_terms' kProjected, without forming the 18 x 18 matrix). Without `with_derivatives` only the
+// energy is computed (the line search's trials).
 LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3& x, const Vec3& load,
-                     const Vec3& origin, bool with_hessian) {
+                     const Vec3& origin, bool with_derivatives) {
   LocalEnergy out;
   auto position = [&](int n) -> const Vec3& { return n == node ? x : mesh.nodes[n].x; };
-  const HessianKind kind = with_hessian ? HessianKind::kProjected : HessianKind::kNone;
   for (const FaceElement& el : els.membrane) {
+    if (!with_derivatives) {
+      out.energy += membrane_terms_energy(position(el.nodes[0]), position(el.nodes[1]), position(el.nodes[2]),
+                                          el.Dm_inv, el.area, el.k, 1.0);
+      continue;
+    }
     const MembraneTerms t = membrane_terms(position(el.nodes[0]), position(el.nodes[1]), position(el.nodes[2]),
-                                           el.Dm_inv, el.area, el.k, 1.0, kind);
+                                           el.Dm_inv, el.area, el.k, 1.0, HessianKind::kProjected);
     out.energy += t.energy;
     for (int i = 0; i < 3; ++i)
       if (el.nodes[i] == node) {
         out.gradient += t.gradient.segment<3>(3 * i);
-        if (with_hessian) out.hessian += t.hessian.block<3, 3>(3 * i, 3 * i);
+        out.hessian += t.hessian.block<3, 3>(3 * i, 3 * i);
       }
   }
-  for (const BendingElement& b : els.bending) {
-    std::array<Vec3, 6> xs;
-    for (int i = 0; i < 6; ++i) xs[i] = position(b.nodes[i]);
-    const PlateBendingTerms t = plate_bending_terms(xs, b.has_wing, b.rest_theta, b.Q, HessianKind::kNone);
-    out.energy += t.energy;
+  for (const NodeBending& nb : els.bending) {
+    const BendingElement& b = nb.el;
+    Vec3 delta = nb.fixed_delta;
+    std::array<Vec12, 3> grad;
+    for (int i = 0; i < 3; ++i) {
+      if (!nb.moves[i]) continue;
+      const auto s = hinge_slots(i);
+      const Vec3 &x0 = position(b.nodes[s[0]]), &x1 = position(b.nodes[s[1]]), &x2 = position(b.nodes[s[2]]),
+                 &x3 = position(b.nodes[s[3]]);
+      delta[i] = wrap_angle(dihedral_angle(x0, x1, x2, x3) - b.rest_theta[i]);
+      if (with_derivatives) grad[i] = dihedral_angle_gradient(x0, x1, x2, x3);
+    }
+    const Vec3 Qd = b.Q * delta;
+    out.energy += delta.dot(Qd);
+    if (!with_derivatives) continue;
     // The node may fill several slots (a corner and, on a tiny mesh, a wing): the derivative sums them.
-    for (int i = 0; i < 6; ++i)
-      if (b.nodes[i] == node && (i < 3 || b.has_wing[i - 3])) out.gradient += t.gradient.segment<3>(3 * i);
-    if (with_hessian) out.hessian += bending_hessian_block(b, xs, node);
+    for (int p = 0; p < 6; ++p) {
+      if (b.nodes[p] != node || (p >= 3 && !b.has_wing[p - 3])) continue;
+      Vec3 slot_gradient = Vec3::Zero();
+      for (int i = 0; i < 3; ++i) {
+        if (!nb.moves[i]) continue;
+        const auto s = hinge_slots(i);
+        for (int a = 0; a < 4; ++a)
+          if (s[a] == p) slot_gradient += 2 * Qd[i] * grad[i].segment<3>(3 * a);
+      }
+      out.gradient += slot_gradient;
+    }
+    std::array<Vec3, 3> a;
+    for (int i = 0; i < 3; ++i) {
+      a[i].setZero();
+      if (!nb.moves[i]) continue;
+      const auto s = hinge_slots(i);
+      for (int k = 0; k < 4; ++k)
+        if (b.nodes[s[k]] == node) a[i] += grad[i].segment<3>(3 * k);
+    }
+    Mat3 H = Mat3::Zero();
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (b.Q(i, j) != 0) H += 2 * b.Q(i, j) * a[i] * a[j].transpose();
+    out.hessian += H;
   }
   out.energy += load.dot(x - origin);
   out.gradient += load;

@@ -77,11 +77,21 @@ WorldGuard::WorldGuard(const Mesh& mesh, const std::vector<const Mesh*>& others,
     : mesh_(mesh), clearance_(clearance) {
   meshes_.push_back(&mesh);
   meshes_.insert(meshes_.end(), others.begin(), others.end());
+  build();
+}
+
+void WorldGuard::build() {
+  cells_.clear();
+  large_.clear();
   // Cells about an edge long: a query touches a few cells and each holds a few faces.
-  cell_ = std::max({median_edge_length(mesh), 4 * clearance, 1e-6});
+  cell_ = std::max({median_edge_length(mesh_), 4 * clearance_, 1e-6});
+  built_faces_ = added_faces_ = 0;
   for (size_t k = 0; k < meshes_.size(); ++k)
     for (size_t f = 0; f < meshes_[k]->faces.size(); ++f)
-      if (!meshes_[k]->faces[f].dead) insert(static_cast<int>(k), static_cast<int>(f));
+      if (!meshes_[k]->faces[f].dead) {
+        insert(static_cast<int>(k), static_cast<int>(f));
+        ++built_faces_;
+      }
 }
 
 WorldGuard::Key WorldGuard::key(int i, int j, int k) const {
@@ -127,7 +137,14 @@ void WorldGuard::insert(int mesh, int face) {
 }
 
 void WorldGuard::update_face(int f) {
-  if (!mesh_.faces[f].dead) insert(0, f);
+  if (mesh_.faces[f].dead) return;
+  // The queries' answers do not depend on the grid (candidates are filtered by their boxes and taken in entry
+  // order), so a rebuild changes no result.
+  if (++added_faces_ > 2 * built_faces_ + 64) {
+    build();
+    return;
+  }
+  insert(0, f);
 }
 
 void WorldGuard::update_node(int n) {
@@ -151,13 +168,23 @@ std::vector<GuardSweep> WorldGuard::fan_sweep(int n, const Vec3& from) const {
 }
 
 std::vector<std::int64_t> WorldGuard::candidates(const Eigen::AlignedBox3d& box) const {
-  std::vector<std::int64_t> found(large_.begin(), large_.end());
+  // Only faces whose box (where they are now) meets the query box: the callers skip the others anyway, and
+  // the grid holds stale and repeated entries of moved faces.
+  std::vector<std::int64_t> found;
+  auto add = [&](std::int64_t entry) {
+    const int mesh = static_cast<int>(entry >> 32), face = static_cast<int>(entry & 0xffffffff);
+    if (mesh == 0 && mesh_.faces[face].dead) return;  // never counts
+    const GuardTriangle t = triangle(mesh, face);
+    if (box.intersects(box_of(t.x, 0))) found.push_back(entry);
+  };
+  for (const std::int64_t entry : large_) add(entry);
   const std::array<int, 3> lo = cell_of(box.min()), hi = cell_of(box.max());
   for (int i = lo[0]; i <= hi[0]; ++i)
     for (int j = lo[1]; j <= hi[1]; ++j)
       for (int k = lo[2]; k <= hi[2]; ++k) {
         const auto it = cells_.find(key(i, j, k));
-        if (it != cells_.end()) found.insert(found.end(), it->second.begin(), it->second.end());
+        if (it != cells_.end())
+          for (const std::int64_t entry : it->second) add(entry);
       }
   std::sort(found.begin(), found.end());
   found.erase(std::unique(found.begin(), found.end()), found.end());
