@@ -142,6 +142,14 @@ void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
   }
 }
 
+int SupernodalLLT::failed_row() const {
+  const cholmod_factor* L = m_cholmodFactor;
+  if (!L || L->minor >= L->n) return -1;
+  // minor is the column of the permuted matrix whose pivot failed; Perm maps it back.
+  const int* perm = static_cast<const int*>(L->Perm);
+  return static_cast<int>(perm ? perm[L->minor] : L->minor);
+}
+
 CholeskySolver::CholeskySolver() = default;
 CholeskySolver::~CholeskySolver() = default;
 
@@ -162,7 +170,7 @@ bool CholeskySolver::factorize(const BlockSystem& system) {
   if (!llt_ || analysed_pattern_ != id) {
     matrix_ = system.pattern->csc_structure();
     system.to_csc(matrix_);
-    llt_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>>();
+    llt_ = std::make_unique<SupernodalLLT>();
     llt_->analyzePattern(matrix_);
     analysed_pattern_ = id;
     ++analyses_;

@@ -111,6 +111,14 @@ void BlockSystem::add_element(const std::array<int, N>& nodes, const std::array<
   }
 }
 
+// CHOLMOD's supernodal LLT that also says where a failed factorisation stopped.
+class SupernodalLLT : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> {
+ public:
+  // The matrix row (in the matrix's own order, not CHOLMOD's fill-reducing permutation) whose pivot was not
+  // positive in the last factorisation; -1 if it succeeded or none ran.
+  int failed_row() const;
+};
+
 // Sparse Cholesky (CHOLMOD, supernodal) of a BlockSystem, reusing the symbolic analysis while the pattern id
 // is unchanged.
 class CholeskySolver {
@@ -124,9 +132,12 @@ class CholeskySolver {
   // Solves with the last factorisation.
   VecX solve(const VecX& rhs);
   int analyses() const { return analyses_; }
+  // After factorize returned false: the matrix row where CHOLMOD met a non-positive pivot (row / 3 is the
+  // system's dof); -1 otherwise.
+  int failed_row() const { return llt_ ? llt_->failed_row() : -1; }
 
  private:
-  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>> llt_;
+  std::unique_ptr<SupernodalLLT> llt_;
   Eigen::SparseMatrix<double> matrix_;
   uint64_t analysed_pattern_ = 0;
   int analyses_ = 0;

@@ -402,7 +402,8 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
   StepTiming times;
   times.assembly = seconds_since(t0);
   const VecX dv = factor_and_solve(solver, system, "implicit step", times, [&] {
-    return explain_indefinite_system(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system);
+    return explain_indefinite_system(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system,
+                                     solver.failed_row());
   });
   for (int i = 0; i < n; ++i) {
     Node& node = mesh.nodes[i];

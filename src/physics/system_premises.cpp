@@ -44,9 +44,12 @@ bool any_free(const SystemDofs& dofs, const int* nodes, int count) {
 
 std::string explain_indefinite_system(const Mesh& mesh, const std::vector<FaceElement>& faces,
                                       const std::vector<BendingElement>& bending, const SystemDofs& dofs,
-                                      const ExternalLoads& loads, double dt, const BlockSystem& system) {
+                                      const ExternalLoads& loads, double dt, const BlockSystem& system,
+                                      int failed_row) {
   std::ostringstream why;
   why.precision(4);
+  const int failed_dof = failed_row >= 0 && failed_row < 3 * dofs.count() ? failed_row / 3 : -1;
+  const int failed_node = failed_dof >= 0 ? dofs.node(failed_dof) : -1;
   // Masses (node numbers are 1-based in messages, as in the OBJ file).
   for (int d = 0; d < dofs.count(); ++d) {
     const int n = dofs.node(d);
@@ -61,21 +64,29 @@ std::string explain_indefinite_system(const Mesh& mesh, const std::vector<FaceEl
   // The element that is stiffest against the masses it moves: dt (dt + beta) lambda_max / min mass. Where that
   // ratio nears 1 / epsilon, the element's round-off exceeds the masses and the factorisation fails although
   // every premise holds.
-  double stiffest_ratio = 0;
-  std::string stiffest;
+  // The same among the elements of the node where the factorisation stopped.
+  double stiffest_ratio = 0, stiffest_here_ratio = 0;
+  std::string stiffest, stiffest_here;
   auto note_stiffness = [&](const char* kind, const auto& nodes, double damping, double largest_eigenvalue,
                             double rest_area) {
     double lightest = kInfinity;
     for (int node : nodes) lightest = std::min(lightest, mesh.nodes[node].mass);
     const double ratio = dt * (dt + damping) * largest_eigenvalue / lightest;
-    if (!(ratio > stiffest_ratio)) return;
-    stiffest_ratio = ratio;
+    const bool here = std::find(nodes.begin(), nodes.end(), failed_node) != nodes.end();
+    if (!(ratio > stiffest_ratio) && !(here && ratio > stiffest_here_ratio)) return;
     std::ostringstream what;
     what.precision(4);
     what << kind << " element of nodes " << node_list(nodes) << " (";
     if (rest_area >= 0) what << "rest area " << rest_area << " m^2, ";
     what << "lightest node " << lightest << " kg): dt (dt + beta) K / m = " << ratio;
-    stiffest = what.str();
+    if (ratio > stiffest_ratio) {
+      stiffest_ratio = ratio;
+      stiffest = what.str();
+    }
+    if (here && ratio > stiffest_here_ratio) {
+      stiffest_here_ratio = ratio;
+      stiffest_here = what.str();
+    }
   };
   // Membrane elements.
   for (size_t i = 0; i < faces.size(); ++i) {
@@ -170,10 +181,45 @@ std::string explain_indefinite_system(const Mesh& mesh, const std::vector<FaceEl
     }
     largest_diagonal = std::max(largest_diagonal, block.trace());
   }
+  // Where CHOLMOD stopped: the blocks of that node and its neighbours form a principal submatrix, positive
+  // definite whenever the whole matrix is; every term being so, an indefinite one means the assembly put a term
+  // in other than as computed (a block dropped, doubled or misplaced), not ill-conditioning.
+  if (failed_dof >= 0) {
+    const BlockPattern& pattern = *system.pattern;
+    std::vector<int> local(dofs.count(), -1), around{failed_dof};
+    for (int k = 0; k < pattern.block_count(); ++k) {
+      if (pattern.block_row(k) == failed_dof) around.push_back(pattern.block_col(k));
+      if (pattern.block_col(k) == failed_dof) around.push_back(pattern.block_row(k));
+    }
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    for (size_t i = 0; i < around.size(); ++i) local[around[i]] = static_cast<int>(i);
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(3 * around.size(), 3 * around.size());
+    for (int k = 0; k < pattern.block_count(); ++k) {
+      const int r = local[pattern.block_row(k)], c = local[pattern.block_col(k)];
+      if (r < 0 || c < 0) continue;
+      A.block<3, 3>(3 * r, 3 * c) = system.blocks[k];
+      if (r != c) A.block<3, 3>(3 * c, 3 * r) = system.blocks[k].transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, Eigen::EigenvaluesOnly);
+    const double smallest = eig.eigenvalues().minCoeff();
+    const double largest = eig.eigenvalues().cwiseAbs().maxCoeff();
+    if (!A.allFinite() || !(smallest > -kNegativeTolerance * largest)) {
+      why << "the factorisation stopped at node " << failed_node + 1 << ", whose blocks with its "
+          << around.size() - 1 << " neighbours are indefinite (smallest eigenvalue " << smallest
+          << " kg) although every element, mass and contact term is positive semi-definite: a term was "
+          << "assembled other than as computed (a block dropped, doubled or misplaced)";
+      return why.str();
+    }
+  }
   why << "every premise holds (positive masses, positive semi-definite element, contact and handle terms), so the "
       << "matrix is too ill-conditioned to factorise: its diagonal spans " << largest_diagonal / smallest_diagonal
       << "x (smallest at node " << smallest_at + 1 << ", dt = " << dt << " s); the stiffest against its masses: "
-      << stiffest << "; try a smaller time step, or a larger remeshing size_min";
+      << stiffest;
+  if (failed_node >= 0)
+    why << "; the factorisation stopped at node " << failed_node + 1
+        << (stiffest_here.empty() ? std::string() : ", whose stiffest: " + stiffest_here);
+  why << "; try a smaller time step, or a larger remeshing size_min";
   return why.str();
 }
 

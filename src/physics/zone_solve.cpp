@@ -133,7 +133,7 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
   assemble_implicit_euler(mesh, faces, bending, dofs, loads, dt, system, options.linearisation);
   out.timing.assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const VecX dv = factor_and_solve(solver, system, "zone step", out.timing, [&] {
-    return explain_indefinite_system(mesh, faces, bending, dofs, loads, dt, system);
+    return explain_indefinite_system(mesh, faces, bending, dofs, loads, dt, system, solver.failed_row());
   });
 
   for (size_t i = 0; i < count; ++i) {

@@ -128,5 +128,25 @@ TEST(BlockSystem, IndefiniteMatrixIsReportedNotSolved) {
   EXPECT_FALSE(solver.factorize(system));
 }
 
+// A failed factorisation says at which row of the matrix (in its own order, whatever CHOLMOD's fill-reducing
+// permutation) the pivot was not positive: the one negative entry of an otherwise positive chain.
+TEST(BlockSystem, FailedFactorisationNamesItsRow) {
+  const int n = 40;
+  std::vector<std::pair<int, int>> pairs;
+  for (int i = 0; i + 1 < n; ++i) pairs.emplace_back(i, i + 1);
+  BlockPattern pattern;
+  pattern.build(n, pairs);
+  BlockSystem system;
+  system.reset(pattern);
+  for (int i = 0; i < n; ++i) system.add_diagonal(i, 4.0 * Mat3::Identity());
+  for (int i = 0; i + 1 < n; ++i) system.blocks[pattern.block_index(i, i + 1)] = -Mat3::Identity();
+  CholeskySolver solver;
+  ASSERT_TRUE(solver.factorize(system));
+  EXPECT_EQ(solver.failed_row(), -1);
+  system.blocks[pattern.diagonal_block(27)](1, 1) = -1.0;
+  ASSERT_FALSE(solver.factorize(system));
+  EXPECT_EQ(solver.failed_row(), 3 * 27 + 1);
+}
+
 }  // namespace
 }  // namespace arcsim

@@ -81,10 +81,44 @@ TEST(SystemPremises, AnIllConditionedSystemNamesItsStiffestElement) {
   ASSERT_FALSE(error.empty()) << "the step did not fail";
   EXPECT_NE(error.find("every premise holds"), std::string::npos) << error;
   EXPECT_NE(error.find("the stiffest against its masses: membrane element of nodes"), std::string::npos) << error;
+  EXPECT_NE(error.find("the factorisation stopped at node "), std::string::npos) << error;
   // And the same sheet at an ordinary stiffness passes the premises and factorises.
   Sheet ordinary(testing::make_grid(4, 4, 0.1, 0.1), 1e6);
   ordinary.build();
   EXPECT_EQ(step_error(ordinary, ExternalLoads(), 1e-2), "");
+}
+
+// Every term is positive semi-definite, but the assembly lost one: node 13's own stiffness block (as a scatter
+// that dropped blocks did, commit ecd4ba2). The explanation does not blame ill-conditioning: it names the node
+// where CHOLMOD stopped (node 13 or a neighbour) and says a term was assembled other than as computed.
+TEST(SystemPremises, AnAssemblyThatLostABlockIsNamedWhereTheFactorisationStopped) {
+  Sheet s(testing::make_grid(5, 5, 0.1, 0.1), 1e9);
+  s.build();
+  for (Node& n : s.mesh.nodes) n.x += Vec3(0.01 * n.x.y() * n.x.y(), 0.003 * n.x.x(), 0.02 * n.x.x() * n.x.y());
+  const int n = static_cast<int>(s.mesh.nodes.size());
+  const int lost = 12;  // an interior node (1-based 13)
+  const double dt = 1e-2;
+  BlockSystem system;
+  system.reset(s.cache.pattern);
+  const SystemDofs dofs = SystemDofs::all_nodes(n);
+  assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, dofs, ExternalLoads(), dt, system);
+  ASSERT_TRUE(s.solver.factorize(system)) << "the sheet as assembled must factorise";
+  EXPECT_EQ(explain_indefinite_system(s.mesh, s.cache.faces, s.cache.bending, dofs, ExternalLoads(), dt, system,
+                                      s.solver.failed_row())
+                .find("assembled other than as computed"),
+            std::string::npos);
+  system.blocks[s.cache.pattern.diagonal_block(lost)] = s.mesh.nodes[lost].mass * Mat3::Identity();
+  ASSERT_FALSE(s.solver.factorize(system));
+  const int failed = s.solver.failed_row() / 3;
+  ASSERT_GE(s.solver.failed_row(), 0);
+  const bool near = failed == lost || s.cache.pattern.block_index(failed, lost) >= 0;
+  EXPECT_TRUE(near) << "stopped at node " << failed + 1;
+  const std::string error = explain_indefinite_system(s.mesh, s.cache.faces, s.cache.bending, dofs, ExternalLoads(),
+                                                      dt, system, s.solver.failed_row());
+  EXPECT_NE(error.find("the factorisation stopped at node " + std::to_string(failed + 1) + ", whose blocks"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("a term was assembled other than as computed"), std::string::npos) << error;
 }
 
 }  // namespace

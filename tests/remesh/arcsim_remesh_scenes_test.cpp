@@ -1,5 +1,5 @@
 // ARCSim 0.3's own cloth scenes with remeshing on (their intended mode): each runs its first 5 simulated seconds
-// without NaN, blow-up, invalid mesh or intersecting triangles. square-pop (ARCSim's test of popping without its pop filter) is also
+// (sphere.json: to its end) without NaN, blow-up, invalid mesh or intersecting triangles. square-pop (ARCSim's test of popping without its pop filter) is also
 // checked for popping: the world surface may change by remeshing only a small fraction of the sheet's motion
 // per frame. Skipped where the ARCSim example folder is absent.
 #include <gtest/gtest.h>
@@ -24,15 +24,15 @@ std::string scene_path(const std::string& name) {
   return std::string(shared ? shared : "/work/shared") + "/arcsim-0.3-scenes/conf/" + name + ".json";
 }
 
-class ArcsimRemeshScene : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(ArcsimRemeshScene, SlowCheckRunsFiveSecondsWithRemeshing) {
-  const std::string path = scene_path(GetParam());
+// Runs ARCSim's scene `name` with remeshing to `end_time` (s), checking every frame: no NaN or blow-up (a
+// NumericalError), a valid mesh, no node flung far, and no intersecting triangles every 5th frame and at the end.
+void run_checked(const char* name, double end_time) {
+  const std::string path = scene_path(name);
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "ARCSim example scenes not found at " << path;
   Scene scene = load_scene(path);
   ASSERT_TRUE(scene.enabled("remeshing"));
   Simulation sim(scene);
-  sim.set_end_time(5.0);
+  sim.set_end_time(end_time);
   // The input mesh first: remeshing adapts it already at the end of frame 1.
   std::vector<int> face_counts{static_cast<int>(sim.cloths[0].mesh.faces.size())};
   while (!sim.finished()) {
@@ -49,7 +49,7 @@ TEST_P(ArcsimRemeshScene, SlowCheckRunsFiveSecondsWithRemeshing) {
       ASSERT_EQ(testing::count_intersecting_pairs(sim), 0) << "frame " << sim.frame();
     }
   }
-  EXPECT_NEAR(sim.time(), 5.0, 1e-9);
+  EXPECT_NEAR(sim.time(), end_time, 1e-9);
   // Remeshing adapted the 2-triangle (square) or coarse (flag) input.
   EXPECT_GT(*std::max_element(face_counts.begin(), face_counts.end()), 4 * face_counts.front() / 3);
   const ModuleTimes& t = sim.times;
@@ -57,17 +57,37 @@ TEST_P(ArcsimRemeshScene, SlowCheckRunsFiveSecondsWithRemeshing) {
   const MeshSizeStats s = mesh_size_stats(sim.cloths[0].mesh);
   std::printf("%s: %d faces, edges %.4f / %.4f / %.4f m; time physics %.2f s, collision %.2f s, remeshing %.2f s "
               "(%.0f%%)\n",
-              GetParam(), s.faces, s.edge_min, s.edge_median, s.edge_max, t.physics, t.collision, t.remeshing,
+              name, s.faces, s.edge_min, s.edge_median, s.edge_max, t.physics, t.collision, t.remeshing,
               100 * t.remeshing / total);
 }
 
-INSTANTIATE_TEST_SUITE_P(Arcsim, ArcsimRemeshScene, ::testing::Values("square", "square-pop", "flag", "sphere"),
-                         [](const auto& param) {
-                           std::string name = param.param;
-                           for (char& ch : name)
-                             if (ch == '-') ch = '_';
-                           return name;
-                         });
+std::string param_name(const ::testing::TestParamInfo<const char*>& param) {
+  std::string name = param.param;
+  for (char& ch : name)
+    if (ch == '-') ch = '_';
+  return name;
+}
+
+class ArcsimRemeshScene : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ArcsimRemeshScene, SlowCheckRunsFiveSecondsWithRemeshing) { run_checked(GetParam(), 5.0); }
+
+INSTANTIATE_TEST_SUITE_P(Arcsim, ArcsimRemeshScene, ::testing::Values("square", "square-pop", "flag"), param_name);
+
+// Scenes run to their own end time (issue 17: every ARCSim scene must). sphere.json (10 s) stopped at 2.76 s with
+// "not positive definite" before commit ecd4ba2 (a node in two slots of a bending element lost its cross blocks);
+// its last 3 s, the sphere dragging and releasing the cloth, are the heaviest (~8k faces). About 10 minutes.
+class ArcsimRemeshSceneToItsEnd : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ArcsimRemeshSceneToItsEnd, SlowCheckRunsToItsEndWithRemeshing) {
+  const std::string path = scene_path(GetParam());
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "ARCSim example scenes not found at " << path;
+  const double end_time = load_scene(path).end_time;
+  ASSERT_GT(end_time, 5.0);
+  run_checked(GetParam(), end_time);
+}
+
+INSTANTIATE_TEST_SUITE_P(Arcsim, ArcsimRemeshSceneToItsEnd, ::testing::Values("sphere"), param_name);
 
 // Largest distance from the nodes of `from` to the surface of `to` (m), over the nodes farther than `skip` from
 // every node of `to` being exact vertices of it (those are unchanged by the remesh and at distance 0). Triangles
