@@ -119,6 +119,8 @@ struct NodeMoveOptions {
   // sphere-break.json added elastic energy (72 J in one step) and its stress cracked the lips' neighbours.
   // Faces of plastic materials are left as they are: a ductile sheet yields to a strain of that size anyway,
   // and their rest shape belongs to the plastic embedding.
+  // Bending, on every face: the rest angle of each hinge the node enters turns with its world angle, so the
+  // move leaves the bending energy as it was.
   bool stress_free = false;
 };
 
