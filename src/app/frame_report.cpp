@@ -58,7 +58,9 @@ std::string frame_log_line(const FrameReport& r) {
         .integer("largest_zone", z.largest_zone)
         .integer("fallback_zones", z.fallback_zones)
         .integer("ill_conditioned_zones", z.ill_conditioned_zones)
-        .integer("unresolved_steps", z.unresolved_steps);
+        .integer("unresolved_steps", z.unresolved_steps)
+        .number("work", z.work)
+        .number("largest_work", z.largest_work);
     line.object("impact_zones", zones);
   }
   if (r.has_fracture) {

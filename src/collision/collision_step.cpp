@@ -27,6 +27,8 @@ void ImpactZoneTotals::add(const ImpactZoneStats& s) {
   fallback_zones += s.fallback_zones;
   ill_conditioned_zones += s.ill_conditioned_zones;
   unresolved_steps += !s.resolved;
+  work += s.work;
+  largest_work = std::max(largest_work, s.work);
 }
 
 std::vector<std::vector<ContactTerm>> CollisionHandler::proximity_terms(const std::vector<const Mesh*>& cloths,
@@ -64,8 +66,10 @@ ImpactZoneStats CollisionHandler::resolve_collisions(const std::vector<Mesh*>& c
   params.floor = settings.floor;
   params.floor_height = settings.floor_height;
   params.step = settings.step;
+  params.work_budget = settings.work_budget;
   const ImpactZoneStats stats = resolve_impacts(geometry_, cache_, params);
   totals_.add(stats);
+  if (stats.out_of_budget) return stats;
 
   for (size_t c = 0; c < cloths.size(); ++c) {
     Mesh& mesh = *cloths[c];

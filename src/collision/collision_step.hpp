@@ -26,6 +26,8 @@ struct CollisionSettings {
   // gap new cracks open with.
   double neighbour_thickness = 0;
   int step = 0;                        // for messages
+  // Work units (collision/impact_zones.hpp) the impact-zone response of one step may spend.
+  double work_budget = kInfinity;
 };
 
 // Impact-zone work summed over the steps since the totals were last cleared (for the run's log), and the
@@ -40,6 +42,8 @@ struct ImpactZoneTotals {
   int fallback_zones = 0;    // zones moved rigidly or held at their start positions
   int ill_conditioned_zones = 0;  // of those, zones whose projection was refused as ill-conditioned
   int unresolved_steps = 0;  // steps whose motion could not be made collision free
+  double work = 0;           // work units (collision/impact_zones.hpp) of the collision responses
+  double largest_work = 0;   // ... of the costliest step
   void add(const ImpactZoneStats& s);
 };
 
@@ -52,7 +56,8 @@ class CollisionHandler {
                                                         const CollisionSettings& settings, double dt);
 
   // After the position update (every node moved x0 -> x): moves cloth nodes so that the motion is collision
-  // free and adds the position change / dt to their velocities.
+  // free and adds the position change / dt to their velocities. When the work budget runs out
+  // (ImpactZoneStats::out_of_budget) the nodes are left as they were; the caller fails the step.
   ImpactZoneStats resolve_collisions(const std::vector<Mesh*>& cloths, const std::vector<const Mesh*>& obstacles,
                                      const CollisionSettings& settings, double dt);
 

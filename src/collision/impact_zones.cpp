@@ -69,12 +69,13 @@ Vec3 end_to_end_normal(const ContactGeometry& g, const std::array<int, 4>& nodes
 }  // namespace
 
 std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params,
-                                         const std::vector<char>* moved) {
+                                         const std::vector<char>* moved, double* work) {
   CandidateOptions options;
   options.margin = params.contact_distance;
   options.swept = true;
   options.moved = moved;
   const std::vector<PrimitivePair> pairs = find_candidates(g, cache, options);
+  if (work) *work += kCcdPairWork * static_cast<double>(pairs.size());
   CcdOptions ccd;
   ccd.contact_distance = params.contact_distance;
 
@@ -181,6 +182,8 @@ class ZoneSet {
   }
 
   std::vector<Zone>& zones() { return zones_; }
+  // Work units of the constraint bookkeeping so far (one per stored constraint compared with a new one).
+  double work() const { return work_; }
 
  private:
   void absorb(int target, int source) {
@@ -194,7 +197,8 @@ class ZoneSet {
     s.alive = false;
   }
 
-  static void add_constraint(Zone& zone, const ImpactRecord& r) {
+  void add_constraint(Zone& zone, const ImpactRecord& r) {
+    work_ += static_cast<double>(zone.constraints.size());
     // A pair detected again with (almost) the same normal refreshes its constraint; a different normal is
     // kept as an additional constraint (the pair's relative orientation changed during the step).
     for (ImpactRecord& c : zone.constraints) {
@@ -209,10 +213,11 @@ class ZoneSet {
   const ContactGeometry& g_;
   std::vector<int> zone_of_;
   std::vector<Zone> zones_;
+  double work_ = 0;
 };
 
 ZoneResult project_zone(Zone& zone, const std::vector<Vec3>& target, ContactGeometry& g,
-                        const ImpactZoneParams& params) {
+                        const ImpactZoneParams& params, double work_limit) {
   std::sort(zone.nodes.begin(), zone.nodes.end());
   auto local = [&](int node) {
     return static_cast<int>(std::lower_bound(zone.nodes.begin(), zone.nodes.end(), node) - zone.nodes.begin());
@@ -241,7 +246,7 @@ ZoneResult project_zone(Zone& zone, const std::vector<Vec3>& target, ContactGeom
     }
     problem.constraints.push_back(c);
   }
-  const ZoneResult result = solve_impact_zone(problem, x, params.method);
+  const ZoneResult result = solve_impact_zone(problem, x, params.method, work_limit);
   for (size_t i = 0; i < zone.nodes.size(); ++i) g.x1[zone.nodes[i]] = x[i];
   return result;
 }
@@ -292,6 +297,7 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
   ZoneSet zones(g);
   auto finish = [&](bool resolved) {
     stats.resolved = resolved;
+    stats.work += zones.work();
     for (const Zone& z : zones.zones()) {
       if (!z.alive || z.nodes.empty()) continue;
       ++stats.zones;
@@ -314,8 +320,17 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
     for (const Zone* z : changed)
       for (int n : z->nodes) moved[n] = 1;
   };
+  // The work budget is checked only between rounds and shared out before each round's (parallel) projections,
+  // so where the response stops does not depend on the threads. A stop leaves the positions part-way: the
+  // caller fails the step.
+  auto spent = [&] { return stats.work + zones.work(); };
+  auto out_of_budget = [&] {
+    stats.out_of_budget = true;
+    return finish(false);
+  };
   for (int iteration = 0; iteration <= params.max_iterations; ++iteration) {
-    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, iteration ? &moved : nullptr);
+    const std::vector<ImpactRecord> impacts =
+        detect_impacts(g, cache, params, iteration ? &moved : nullptr, &stats.work);
     stats.iterations = iteration + 1;
     if (iteration == 0) stats.impacts = static_cast<int>(impacts.size());
     if (impacts.empty()) return finish(true);
@@ -324,13 +339,20 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       break;
     }
     zones.add(impacts);
+    if (!(spent() < params.work_budget)) return out_of_budget();
     std::vector<Zone*> dirty;
     size_t zone_nodes = 0;
+    double zone_work = 0;
     for (Zone& z : zones.zones()) {
       if (!z.alive || !z.dirty) continue;
       dirty.push_back(&z);
       zone_nodes += z.nodes.size();
+      zone_work += zone_evaluation_work(static_cast<int>(z.nodes.size()), z.constraints.size());
     }
+    // Each zone may spend the budget left in proportion to its size, so that a round cannot overspend it.
+    const double left = params.work_budget - spent();
+    std::vector<double> work(dirty.size(), 0.0);
+    std::vector<char> stopped(dirty.size(), 0);
     // An ill-conditioned projection (zone_solver.hpp) is not applied: the zone moves rigidly from then on,
     // and the fallback rounds below hold it at x0 if that collides too.
     std::vector<double> ill_ratio(dirty.size(), 0.0);
@@ -338,7 +360,12 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
     for (int k = 0; k < static_cast<int>(dirty.size()); ++k) {
       Zone& z = *dirty[k];
       if (z.state == ZoneState::kProjected) {
-        const ZoneResult r = project_zone(z, target, g, params);
+        const double share =
+            left * (zone_evaluation_work(static_cast<int>(z.nodes.size()), z.constraints.size()) / zone_work);
+        const ZoneResult r = project_zone(z, target, g, params, share);
+        work[k] = r.work;
+        stopped[k] = r.out_of_budget;
+        if (r.out_of_budget) continue;
         if (r.ill_conditioned) {
           z.state = ZoneState::kRigid;
           ill_ratio[k] = r.move_ratio;
@@ -347,6 +374,8 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       if (z.state != ZoneState::kProjected) move_rigidly(z, target, g);
       z.dirty = false;
     }
+    for (size_t k = 0; k < dirty.size(); ++k) stats.work += work[k];
+    if (std::find(stopped.begin(), stopped.end(), 1) != stopped.end()) return out_of_budget();
     for (size_t k = 0; k < dirty.size(); ++k) {
       if (ill_ratio[k] == 0) continue;
       ++stats.ill_conditioned_zones;
@@ -392,10 +421,11 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
     }
     if (changed.empty()) break;
     mark_moved(changed);
-    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, &moved);
+    const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, &moved, &stats.work);
     ++stats.iterations;
     if (impacts.empty()) return finish(true);
     zones.add(impacts);
+    if (!(spent() < params.work_budget)) return out_of_budget();
   }
   std::ostringstream what;
   what << "collisions remain unresolved (zones held at their start positions are hit by moving obstacles "

@@ -27,7 +27,16 @@ struct ImpactZoneParams {
   double floor_height = 0;         // m
   ZoneMethod method = ZoneMethod::kAutomatic;
   int step = 0;                    // for messages
+  // Work budget of one resolve_impacts, in work units (zone_evaluation_work per evaluation of a zone's
+  // projection, kCcdPairWork per candidate pair tested): once spent, the response stops unresolved with
+  // ImpactZoneStats::out_of_budget. Counted, not timed, so that where it stops is the same on every machine and
+  // with any number of threads.
+  double work_budget = kInfinity;
 };
+
+// Work units of one candidate pair's continuous collision test (about its cost against one constraint term of a
+// zone evaluation).
+constexpr double kCcdPairWork = 100;
 
 struct ImpactRecord {
   int kind = 0;                    // PairKind, or kFloorImpact
@@ -42,8 +51,9 @@ constexpr int kFloorImpact = 3;
 
 // Every impact of the motion x0 -> x1 of the geometry (at most one per primitive pair: the first), in a
 // deterministic order. With `moved` (a flag per node), only impacts involving a flagged node.
+// With `work`, adds the detection's work units (kCcdPairWork per candidate pair).
 std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cache, const ImpactZoneParams& params,
-                                         const std::vector<char>* moved = nullptr);
+                                         const std::vector<char>* moved = nullptr, double* work = nullptr);
 
 struct ImpactZoneStats {
   int iterations = 0;        // detection rounds
@@ -53,6 +63,9 @@ struct ImpactZoneStats {
   int fallback_zones = 0;    // zones moved rigidly, carried with obstacles or held at x0
   int ill_conditioned_zones = 0;  // projections refused as ill-conditioned (those zones also count as fallback)
   bool resolved = true;      // the final motion is collision free
+  double work = 0;           // work units spent (ImpactZoneParams::work_budget)
+  bool out_of_budget = false;  // stopped, unresolved, when the work budget ran out (the positions are then
+                               // part-way and must not be kept)
   // Nodes (geometry indices, sorted) of the zones on a fallback: their end positions are not the
   // physics' outcome, and the strain between them and their neighbours is not the material's.
   std::vector<int> fallback_nodes;

@@ -17,10 +17,14 @@ struct ScaledZone {
   std::vector<double> relative_mass;  // m_i / m_mean
   std::vector<double> b;
   int evaluations = 0;
+  double max_evaluations = kInfinity;  // the work limit's: past it an evaluation stops the optimiser
 };
 
 double objective(unsigned n, const double* y, double* grad, void* data) {
   auto* z = static_cast<ScaledZone*>(data);
+  // NLopt's evaluation limits are not exact for every method (AUGLAG's inner optimiser runs on past them); this
+  // is. NLopt's wrapper turns the exception into a forced stop that keeps the best point so far.
+  if (!(z->evaluations < z->max_evaluations)) throw nlopt::forced_stop();
   ++z->evaluations;
   double f = 0;
   for (unsigned j = 0; j < n; ++j) {
@@ -93,19 +97,23 @@ double augmented_lagrangian(unsigned n, const double* y, double* grad, void* dat
 // impacts per round). More, cheaper outer rounds replace the large penalties.
 constexpr double kMaxPenalty = 1e4;
 constexpr int kMaxOuterIterations = 200;
+constexpr int kMaxInnerEvaluations = 1000;
+// At most zone.max_evaluations evaluations in all.
 void sparse_augmented_lagrangian(ScaledZone& zone, std::vector<double>& y) {
   const unsigned n = static_cast<unsigned>(y.size());
   const size_t m = zone.b.size();
   AugmentedLagrangian al{&zone, std::vector<double>(m, 0.0), 10.0};
   double previous_violation = kInfinity;
   for (int outer = 0; outer < kMaxOuterIterations; ++outer) {
+    const double left = zone.max_evaluations - zone.evaluations;
+    if (!(left >= 1)) return;
     nlopt::opt inner(nlopt::LD_LBFGS, n);
     inner.set_min_objective(augmented_lagrangian, &al);
     // Loose inner tolerances: the multiplier updates correct what an inexact inner solve leaves (tightening
     // to 1e-7 / 1e-14 made resting-contact zones ~8x slower for no gain in the final gaps).
     inner.set_xtol_abs(1e-5);
     inner.set_ftol_rel(1e-10);
-    inner.set_maxeval(1000);
+    inner.set_maxeval(static_cast<int>(std::min<double>(kMaxInnerEvaluations, left)));
     inner.set_vector_storage(10);
     try {
       double f = 0;
@@ -120,7 +128,7 @@ void sparse_augmented_lagrangian(ScaledZone& zone, std::vector<double>& y) {
       al.lambda[k] = std::max(0.0, al.lambda[k] + al.mu * c);
       slack = std::max(slack, al.lambda[k] * std::abs(c));
     }
-    if (violation <= 1e-3 && slack <= 1e-4) break;
+    if (violation <= 1e-3 && slack <= 1e-4) return;
     if (violation > 0.25 * previous_violation) al.mu = std::min(al.mu * 10, kMaxPenalty);
     previous_violation = violation;
   }
@@ -154,7 +162,8 @@ double worst_zone_gap(const ZoneProblem& problem, const std::vector<Vec3>& x) {
   return worst;
 }
 
-ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, ZoneMethod method) {
+ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, ZoneMethod method,
+                             double work_limit) {
   ZoneResult result;
   const int nodes = static_cast<int>(problem.target.size());
   const double h = problem.thickness;
@@ -181,6 +190,13 @@ ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, Z
                                                        : ZoneMethod::kSparseAugmentedLagrangian;
   // Constraint tolerance in units of the thickness: the gap is enforced to within 0.1%.
   const std::vector<double> tolerance(m, 1e-3);
+  const double per_evaluation = zone_evaluation_work(nodes, m);
+  zone.max_evaluations = std::floor(work_limit / per_evaluation);
+  if (!(zone.max_evaluations >= 1)) {
+    result.out_of_budget = true;
+    result.worst_gap = worst_zone_gap(problem, x);
+    return result;
+  }
   try {
     if (method == ZoneMethod::kSlsqp) {
       nlopt::opt opt(nlopt::LD_SLSQP, n);
@@ -219,6 +235,7 @@ ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, Z
     finite = finite && solution[i].allFinite();
   }
   result.evaluations = zone.evaluations;
+  result.work = zone.evaluations * per_evaluation;
   if (finite) {
     result.move_ratio = largest_move(problem, solution) / required_move(problem);
     result.ill_conditioned = !(result.move_ratio <= kMaxZoneMoveRatio);
@@ -226,6 +243,7 @@ ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x, Z
   }
   result.worst_gap = worst_zone_gap(problem, x);
   result.solved = finite && !result.ill_conditioned && result.worst_gap >= 0.5 * h;
+  result.out_of_budget = !(zone.evaluations < zone.max_evaluations) && !result.solved;
   return result;
 }
 

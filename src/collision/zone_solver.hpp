@@ -59,7 +59,16 @@ struct ZoneResult {
   double worst_gap = 0;   // smallest constraint gap at the result (m)
   double move_ratio = 0;  // largest node move / required_move
   int evaluations = 0;    // objective evaluations
+  double work = 0;        // work units spent (evaluations x zone_evaluation_work)
+  bool out_of_budget = false;  // stopped by its work limit before it converged
 };
+
+// The work of one evaluation of a zone's objective and constraints (or of its augmented Lagrangian), in the
+// collision budget's work units (impact_zones.hpp): one per constraint and one per variable, the terms an
+// evaluation and the optimiser's update touch. Deterministic, unlike wall time.
+inline double zone_evaluation_work(int nodes, size_t constraints) {
+  return static_cast<double>(constraints) + 3.0 * nodes;
+}
 
 // The deepest violation of the problem's constraints at the target positions, or the thickness if larger (m).
 double required_move(const ZoneProblem& problem);
@@ -72,8 +81,9 @@ double worst_zone_gap(const ZoneProblem& problem, const std::vector<Vec3>& x);
 
 // Solves starting from `x` (same size as problem.target) and writes the result back to `x`. Never throws; a
 // failed optimisation leaves its best point in `x` and reports solved = false; an ill-conditioned one leaves
-// `x` as it was.
+// `x` as it was. The optimiser stops once it has spent `work_limit` work units (zone_evaluation_work per
+// evaluation; kAugmentedLagrangian may take one evaluation more); then out_of_budget unless it had solved it.
 ZoneResult solve_impact_zone(const ZoneProblem& problem, std::vector<Vec3>& x,
-                             ZoneMethod method = ZoneMethod::kAutomatic);
+                             ZoneMethod method = ZoneMethod::kAutomatic, double work_limit = kInfinity);
 
 }  // namespace arcsim

@@ -439,6 +439,7 @@ class SceneParser {
     }
     scene_.passive_time = get_real(top.get("passive_time"), kInfinity, or_infinite(kNonNegative));
     parse_adaptive_step(top.get("adaptive_time_step"));
+    scene_.collision_budget = get_real(top.get("collision_budget"), kDefaultCollisionBudget, kPositive);
   }
 
   // `adaptive_time_step`: true, false, or an object of settings (an object turns it on unless "enabled": false).

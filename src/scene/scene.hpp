@@ -118,6 +118,10 @@ struct AdaptiveStepSpec {
   int grow_after = 8;              // steps at a level before a coarser one is tried
 };
 
+// The default collision_budget (work units per cloth node and step). See docs/scene-format.md for the figures it
+// was chosen from.
+constexpr double kDefaultCollisionBudget = 1e6;
+
 struct Scene {
   std::string path;             // the scene file
   std::string base_dir;         // folder paths are resolved against first
@@ -130,6 +134,10 @@ struct Scene {
   int save_every = 1;
   double passive_time = kInfinity;
   AdaptiveStepSpec adaptive_step;
+  // Work units (collision/impact_zones.hpp) a step's collision response may spend per cloth node (scene key
+  // `collision_budget`, ours); past it the step fails as a numerical failure. WHY a count: a time limit would
+  // make results depend on the machine and its load.
+  double collision_budget = kDefaultCollisionBudget;
   std::vector<ClothSpec> cloths;
   std::vector<Motion> motions;
   std::vector<HandleSpec> handles;

@@ -225,6 +225,16 @@ void Simulation::physics_step(double dt) {
   }
 }
 
+namespace {
+
+size_t cloth_node_count(const std::vector<Cloth>& cloths) {
+  size_t nodes = 0;
+  for (const Cloth& c : cloths) nodes += c.mesh.nodes.size();
+  return nodes;
+}
+
+}  // namespace
+
 CollisionSettings Simulation::collision_settings() const {
   CollisionSettings s;
   const MagicParams& magic = scene_.magic;
@@ -238,6 +248,7 @@ CollisionSettings Simulation::collision_settings() const {
   // keeps the full thickness between all parts of a sheet, as ARCSim has it (its frames stay as they were).
   s.neighbour_thickness = scene_.enabled("fracture") ? fracture.opening.lip_gap : s.repulsion_thickness;
   s.step = step_;
+  s.work_budget = scene_.collision_budget * static_cast<double>(cloth_node_count(cloths));
   // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
   for (const Obstacle& o : obstacles) {
     if (!o.floor || !o.active) continue;
@@ -269,8 +280,21 @@ std::vector<std::vector<ContactTerm>> Simulation::proximity_step(double dt) {
 void Simulation::collision_step(double dt) {
   std::vector<Mesh*> cloth_meshes;
   for (Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
-  collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
+  const CollisionSettings settings = collision_settings();
+  const ImpactZoneStats stats =
+      collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), settings, dt);
   step_fallback_nodes_ = collisions_.fallback_nodes();
+  if (!stats.out_of_budget) return;
+  // The cause alone under adaptive time stepping, which redoes the step in substeps and names the step if
+  // even its smallest substep fails.
+  std::ostringstream msg;
+  if (!scene_.adaptive_step.enabled) msg << "step " << step_ << " (t = " << time_ - dt << " to " << time_ << " s): ";
+  msg << "collision handling did not converge within its budget (" << stats.work << " work units; collision_budget "
+      << scene_.collision_budget << " per node x " << cloth_node_count(cloths) << " nodes): " << stats.zones
+      << " impact zones, the largest " << stats.largest_zone << " nodes";
+  if (!scene_.adaptive_step.enabled)
+    msg << "; try adaptive_time_step, a smaller time step, or a larger collision_budget";
+  throw NumericalError(msg.str());
 }
 
 std::string Simulation::nonfinite_state() const {

@@ -73,6 +73,43 @@ TEST(ImpactZones, SheetPassingThroughPlateStopsAtTheGap) {
   }
 }
 
+// The work budget: the same sheet with too small a budget stops unresolved and says so, having spent no more than
+// the budget and one detection round; with a budget that covers its work it resolves exactly as without one.
+TEST(ImpactZones, WorkBudgetStopsTheResponseUnresolved) {
+  auto run = [](double budget, ContactGeometry& g) {
+    Mesh s = sheet(4, 0.2, 0.1, 0.15, 1e-3), p = plate(0);
+    for (Node& n : s.nodes) {
+      n.x0 = n.x + Vec3(0, 0, 0.01);
+      n.x = n.x + Vec3(0.003, 0, -0.01);
+    }
+    build_contact_geometry({{&s, true}, {&p, false}}, ContactStage::kAfterStep, 1e-3, g);
+    BvhCache cache;
+    ImpactZoneParams params_with_budget = params();
+    params_with_budget.work_budget = budget;
+    return resolve_impacts(g, cache, params_with_budget);
+  };
+  ContactGeometry free, enough, short_of_it;
+  const ImpactZoneStats unlimited = run(kInfinity, free);
+  ASSERT_TRUE(unlimited.resolved);
+  EXPECT_FALSE(unlimited.out_of_budget);
+  ASSERT_GT(unlimited.work, 0);
+
+  const ImpactZoneStats stopped = run(0.2 * unlimited.work, short_of_it);
+  EXPECT_TRUE(stopped.out_of_budget);
+  EXPECT_FALSE(stopped.resolved);
+  EXPECT_LT(stopped.work, unlimited.work);
+  // The zones it had when it stopped (for the message), within the sheet's 25 nodes.
+  EXPECT_GE(stopped.zones, 1);
+  EXPECT_GE(stopped.largest_zone, 1);
+  EXPECT_LE(stopped.largest_zone, 25);
+
+  const ImpactZoneStats covered = run(2 * unlimited.work, enough);
+  EXPECT_TRUE(covered.resolved);
+  EXPECT_FALSE(covered.out_of_budget);
+  EXPECT_EQ(covered.work, unlimited.work);
+  EXPECT_EQ(enough.x1, free.x1);
+}
+
 // Two nearly parallel edges whose small angle lies across the surface: a sheet's diagonal resting on a plate
 // along the plate's diagonal, tilted by 0.01 rad out of the plate and 0.002 rad within it, sliding sideways and
 // down through it. Their cross product lies nearly in the plate, and as the impact's normal it pushed the

@@ -204,5 +204,43 @@ TEST(ZoneSolver, ContradictingConstraintsAreIllConditionedAndNotApplied) {
   EXPECT_NEAR(largest_move(p, x), kGap, 1e-3 * kGap);
 }
 
+// The work limit: each method spends at most what it is given (in zone_evaluation_work units), reports running out
+// when that stops it short of a solution, and with enough for its whole solve gives the unlimited result exactly.
+TEST(ZoneSolver, WorkLimitStopsTheOptimiserAndIsReported) {
+  const ZoneProblem p = random_zone(24, 64);
+  const double per_evaluation = zone_evaluation_work(24, p.constraints.size());
+  for (ZoneMethod method : {ZoneMethod::kSlsqp, ZoneMethod::kAugmentedLagrangian, ZoneMethod::kSparseAugmentedLagrangian}) {
+    SCOPED_TRACE(static_cast<int>(method));
+    std::vector<Vec3> free = p.target;
+    const ZoneResult unlimited = solve_impact_zone(p, free, method);
+    ASSERT_TRUE(unlimited.solved);
+    EXPECT_FALSE(unlimited.out_of_budget);
+    EXPECT_EQ(unlimited.work, unlimited.evaluations * per_evaluation);
+    ASSERT_GT(unlimited.evaluations, 12);
+
+    std::vector<Vec3> x = p.target;
+    const double limit = 1 * per_evaluation;
+    const ZoneResult stopped = solve_impact_zone(p, x, method, limit);
+    EXPECT_TRUE(stopped.out_of_budget);
+    EXPECT_FALSE(stopped.solved);
+    // (NLopt's AUGLAG checks its count only after its inner optimiser returns: one evaluation more.)
+    EXPECT_LE(stopped.work, limit + per_evaluation);
+
+    // Too little for a single evaluation: nothing is tried.
+    x = p.target;
+    const ZoneResult none = solve_impact_zone(p, x, method, 0.5 * per_evaluation);
+    EXPECT_TRUE(none.out_of_budget);
+    EXPECT_EQ(none.evaluations, 0);
+    EXPECT_EQ(max_difference(x, p.target), 0.0);
+
+    x = p.target;
+    const ZoneResult enough = solve_impact_zone(p, x, method, 2 * unlimited.work);
+    EXPECT_TRUE(enough.solved);
+    EXPECT_FALSE(enough.out_of_budget);
+    EXPECT_EQ(enough.evaluations, unlimited.evaluations);
+    EXPECT_EQ(max_difference(x, free), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace arcsim
