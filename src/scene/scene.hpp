@@ -8,6 +8,7 @@
 
 #include "math/types.hpp"
 #include "physics/material.hpp"
+#include "physics/solver_settings.hpp"
 #include "scene/transform.hpp"
 
 namespace arcsim {
@@ -130,6 +131,7 @@ struct Scene {
   int save_every = 1;
   double passive_time = kInfinity;
   AdaptiveStepSpec adaptive_step;
+  SolverSettings solver;        // scene key `solver` (ours)
   std::vector<ClothSpec> cloths;
   std::vector<Motion> motions;
   std::vector<HandleSpec> handles;
