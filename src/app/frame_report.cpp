@@ -1,5 +1,6 @@
 #include "app/frame_report.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "app/json_line.hpp"
@@ -84,6 +85,17 @@ std::string frame_log_line(const FrameReport& r) {
         .number("smallest", r.smallest_step);
     if (!r.retry_cause.empty()) step.text("cause", r.retry_cause);
     line.object("time_step", step);
+  }
+  if (r.solves > 0) {
+    JsonLine solver;
+    double max_residual = 0;
+    for (double x : r.residuals) max_residual = std::max(max_residual, x);
+    solver.integer("solves", r.solves)
+        .integer("factorizations", r.factorizations)
+        .integer("iterations", r.solver_iterations)
+        .number("max_residual", max_residual)
+        .numbers("residuals", r.residuals);
+    line.object("solver", solver);
   }
   return line.str();
 }

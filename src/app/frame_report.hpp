@@ -38,6 +38,9 @@ struct FrameReport {
   ImpactZoneTotals impact_zones;     // summed over the frame's steps
   bool has_fracture = false;         // the fracture module ran in this frame: fracture below is meaningful
   FractureStats fracture;            // summed over the frame's steps and cloths
+  // The implicit step's linear solves over the frame's steps and cloths (CholeskySolver::solve_system).
+  int solves = 0, factorizations = 0, solver_iterations = 0;
+  std::vector<double> residuals;     // per solve, in order: |A dv - b| / |b|
   bool has_time_step = false;        // adaptive time stepping is on: the fields below are meaningful
   int substeps = 0;                  // dynamics substeps taken in this frame
   int retries = 0;                   // failed attempts redone with a smaller step
@@ -54,7 +57,8 @@ struct FrameReport {
 // "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones, then "fracture":{"cracks":..,
 // "refused":..,"substeps":..,"candidates":..,"largest_zone":..,"remesh_edits":..,"max_ratio":..,"seconds":..}
 // when has_fracture (max_ratio: the largest separation strength / toughness seen at a step's first evaluation),
-// then "time_step":{"substeps":..,"retries":..,"level":..,"smallest":..[,"cause":".."]} when has_time_step.
+// then "time_step":{"substeps":..,"retries":..,"level":..,"smallest":..[,"cause":".."]} when has_time_step, then
+// "solver":{"solves":..,"factorizations":..,"iterations":..,"max_residual":..,"residuals":[..]} when solves > 0.
 std::string frame_log_line(const FrameReport& report);
 
 // {"frame":..,"total":..,"time":..,"faces":..,"nodes":..,"wall":..}; total is null when the run is unbounded,

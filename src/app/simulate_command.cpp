@@ -164,6 +164,10 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   report.substep_level = sim.time_step_stats.level;
   report.smallest_step = sim.time_step_stats.smallest;
   report.retry_cause = sim.time_step_stats.cause;
+  report.solves = sim.times.solver.solves;
+  report.factorizations = sim.times.solver.factorizations;
+  report.solver_iterations = sim.times.solver.iterations;
+  report.residuals = sim.times.solver.residuals;
 }
 
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {

@@ -349,6 +349,7 @@ class SceneParser {
     parse_disable(top.get("disable"));
     parse_magic(top.get("magic"));
     parse_fracture(top.get("fracture"));
+    parse_solver(top.get("solver"));
     parse_cloths(top.get("cloths"));
     parse_motions(top.get("motions"));
     parse_handles(top.get("handles"));
@@ -505,6 +506,17 @@ class SceneParser {
     m.relax_method = get_int(r.get("relax_method"), m.relax_method, 0, 1);
     m.max_cracks = get_int(r.get("max_cracks"), m.max_cracks, 0);
     m.enable_localopt = get_bool(r.get("enable_localopt"), m.enable_localopt);
+    r.warn_unknown();
+  }
+
+  // `solver` (ours): how the implicit step's linear systems are solved (physics/solver_settings.hpp).
+  void parse_solver(const Found& f) {
+    if (!f) return;
+    SolverSettings& s = scene_.solver;
+    ObjectReader r(*f.value, f.at, scene_.warnings);
+    s.pcg_min_nodes = get_int(r.get("pcg_min_nodes"), s.pcg_min_nodes, 0);
+    s.pcg_tolerance = get_real(r.get("pcg_tolerance"), s.pcg_tolerance, Limits{0, 1, true, true});
+    s.pcg_max_iterations = get_int(r.get("pcg_max_iterations"), s.pcg_max_iterations, 1, 1000);
     r.warn_unknown();
   }
 

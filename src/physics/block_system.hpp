@@ -16,6 +16,7 @@
 #include <Eigen/Sparse>
 
 #include "math/types.hpp"
+#include "physics/solver_settings.hpp"
 
 namespace arcsim {
 
@@ -119,8 +120,16 @@ class SupernodalLLT : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   int failed_row() const;
 };
 
-// Sparse Cholesky (CHOLMOD, supernodal) of a BlockSystem, reusing the symbolic analysis while the pattern id
-// is unchanged.
+// What one solve_system did.
+struct SolveReport {
+  bool factorized = false;  // the matrix was factorised (the solve is direct)
+  int iterations = 0;       // conjugate-gradient iterations (0 for a direct solve)
+  double residual = 0;      // |A x - b| / |b| of the returned x (0 when b = 0)
+  double factor_seconds = 0, solve_seconds = 0;  // wall: the factorisation (and analysis); the rest
+};
+
+// Sparse Cholesky (CHOLMOD, supernodal, AMD ordering) of a BlockSystem, reusing the symbolic analysis while the
+// pattern id is unchanged, and for large systems the numeric factorisation too (SolverSettings).
 class CholeskySolver {
  public:
   CholeskySolver();
@@ -131,16 +140,37 @@ class CholeskySolver {
   bool factorize(const BlockSystem& system);
   // Solves with the last factorisation.
   VecX solve(const VecX& rhs);
+  // Solves the system as `settings()` say: x = A^-1 b directly after a factorisation, or by preconditioned
+  // conjugate gradients with a kept factorisation. Returns false (x undefined) if a factorisation it needed
+  // failed (the matrix is not positive definite). Every step is serial and in a fixed order: the result does
+  // not depend on the thread count. A conjugate-gradient solve does not prove the matrix definite; one that meets
+  // a direction of non-positive curvature falls back to a factorisation, which then fails.
+  bool solve_system(const BlockSystem& system, VecX& x, SolveReport& report);
+  // The next solve_system factorises (the simulation asks for it at each frame's first step, so that a run
+  // resumed from a frame's state takes the same solves as one that ran through).
+  void refresh() { factor_current_ = false; }
+  const SolverSettings& settings() const { return settings_; }
+  void set_settings(const SolverSettings& settings) { settings_ = settings; }
   int analyses() const { return analyses_; }
-  // After factorize returned false: the matrix row where CHOLMOD met a non-positive pivot (row / 3 is the
+  int factorizations() const { return factorizations_; }
+  // After a failed factorisation: the matrix row where CHOLMOD met a non-positive pivot (row / 3 is the
   // system's dof); -1 otherwise.
   int failed_row() const { return llt_ ? llt_->failed_row() : -1; }
 
  private:
+  // Factorises matrix_ (already filled); false if that failed.
+  bool factorize_matrix();
+  // Up to pcg_max_iterations of conjugate gradients preconditioned with the kept factor; false if they did not
+  // reach the tolerance (or met non-positive curvature).
+  bool conjugate_gradients(const BlockSystem& system, VecX& x, int& iterations);
+
   std::unique_ptr<SupernodalLLT> llt_;
   Eigen::SparseMatrix<double> matrix_;
   uint64_t analysed_pattern_ = 0;
+  bool factor_current_ = false;  // llt_ holds a factorisation of a matrix on analysed_pattern_
+  SolverSettings settings_;
   int analyses_ = 0;
+  int factorizations_ = 0;
 };
 
 }  // namespace arcsim

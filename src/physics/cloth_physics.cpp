@@ -366,17 +366,30 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
   }
 }
 
+void StepTiming::add(const StepTiming& other) {
+  assembly += other.assembly;
+  factorization += other.factorization;
+  solve += other.solve;
+  solves += other.solves;
+  factorizations += other.factorizations;
+  iterations += other.iterations;
+  residuals.insert(residuals.end(), other.residuals.begin(), other.residuals.end());
+}
+
 VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,
                       StepTiming& timing, const std::function<std::string()>& explain) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (!solver.factorize(system))
+  VecX dv;
+  SolveReport report;
+  if (!solver.solve_system(system, dv, report))
     throw NumericalError(step + ": the system matrix is not positive definite (CHOLMOD factorisation failed" +
                          (explain ? ": " + explain() : std::string()) + "); the simulation is unstable");
-  const auto t1 = std::chrono::steady_clock::now();
-  VecX dv = solver.solve(system.rhs);
   if (!dv.allFinite()) throw NumericalError(step + ": velocity update is not finite");
-  timing.factorization += std::chrono::duration<double>(t1 - t0).count();
-  timing.solve += seconds_since(t1);
+  timing.factorization += report.factor_seconds;
+  timing.solve += report.solve_seconds;
+  ++timing.solves;
+  timing.factorizations += report.factorized ? 1 : 0;
+  timing.iterations += report.iterations;
+  timing.residuals.push_back(report.residual);
   return dv;
 }
 
@@ -412,11 +425,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
     node.x0 = node.x;
     node.x += dt * node.v;
   }
-  if (timing) {
-    timing->assembly += times.assembly;
-    timing->factorization += times.factorization;
-    timing->solve += times.solve;
-  }
+  if (timing) timing->add(times);
 }
 
 }  // namespace arcsim

@@ -112,8 +112,12 @@ struct ExternalLoads {
 // audits (Simulation::audit_energy); implicit Euler never raises it without external work.
 double mechanical_energy(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads);
 
+// Wall times and what the linear solves did (CholeskySolver::solve_system), summed over the solves.
 struct StepTiming {
   double assembly = 0, factorization = 0, solve = 0;  // wall seconds
+  int solves = 0, factorizations = 0, iterations = 0;  // iterations: conjugate-gradient ones
+  std::vector<double> residuals;  // per solve, in order: |A dv - b| / |b|
+  void add(const StepTiming& other);
 };
 
 // Assembles the linearised backward Euler system of one step of size dt (s) over the rows of `dofs`:
@@ -134,8 +138,8 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
                              const ExternalLoads& loads, double dt, BlockSystem& system,
                              Linearisation linearisation = Linearisation::kStep);
 
-// Factorises the assembled system and solves it for dv, adding the wall times to timing.factorization and
-// timing.solve. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the
+// Solves the assembled system for dv (CholeskySolver::solve_system: factorised, or by conjugate gradients with a
+// kept factorisation for large systems), adding the wall times and the solve's report to `timing`. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the
 // matrix is not positive definite or dv is not finite; `explain`, if given, says why the matrix failed
 // (physics/system_premises.hpp) and is called only then.
 VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const std::string& step,

@@ -8,6 +8,7 @@
 
 #include "math/types.hpp"
 #include "physics/material.hpp"
+#include "physics/solver_settings.hpp"
 #include "scene/transform.hpp"
 
 namespace arcsim {
@@ -138,6 +139,7 @@ struct Scene {
   // `collision_budget`, ours); past it the step fails as a numerical failure. WHY a count: a time limit would
   // make results depend on the machine and its load.
   double collision_budget = kDefaultCollisionBudget;
+  SolverSettings solver;        // scene key `solver` (ours)
   std::vector<ClothSpec> cloths;
   std::vector<Motion> motions;
   std::vector<HandleSpec> handles;

@@ -221,6 +221,7 @@ void Simulation::physics_step(double dt) {
     ExternalLoads loads = loads_for(static_cast<int>(c), time_);
     if (c < step_contacts_.size()) loads.contacts = step_contacts_[c];
     update_contact_pattern(cloth.elements, loads.contacts);
+    cloth.solver.set_settings(scene_.solver);
     implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads, dt, &times.solver);
   }
 }
@@ -339,7 +340,12 @@ void Simulation::advance_step() {
   const double start = time_;
   time_ += dt;
   ++step_;
-  if ((step_ - 1) % frame_steps_ == 0) time_step_stats = TimeStepStats();
+  if ((step_ - 1) % frame_steps_ == 0) {
+    time_step_stats = TimeStepStats();
+    // A frame's first step factorises afresh: a run resumed from a frame's state (which holds no factorisation)
+    // then takes the same solves as one that ran through.
+    for (Cloth& cloth : cloths) cloth.solver.refresh();
+  }
   jitter_step();
 
   // Proximity forces enter the implicit solve; the impact-zone response follows the position update.

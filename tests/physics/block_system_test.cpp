@@ -148,5 +148,134 @@ TEST(BlockSystem, FailedFactorisationNamesItsRow) {
   EXPECT_EQ(solver.failed_row(), 3 * 27 + 1);
 }
 
+// A random definite block system on a random pattern: blocks of A A^T element matrices scaled by `stiffness`,
+// plus `mass` on the diagonal. The same seed gives the same pattern and directions whatever the scales.
+struct RandomSystem {
+  BlockPattern pattern;
+  BlockSystem system;
+  Eigen::MatrixXd dense;
+
+  RandomSystem(int n, unsigned seed, double stiffness, double mass, double perturbation = 0) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<std::array<int, 3>> elements;
+    std::vector<std::pair<int, int>> pairs;
+    for (int k = 0; k < 4 * n; ++k) {
+      std::array<int, 3> e{static_cast<int>(rng() % n), static_cast<int>(rng() % n), static_cast<int>(rng() % n)};
+      if (e[0] == e[1] || e[1] == e[2] || e[0] == e[2]) continue;
+      elements.push_back(e);
+      pairs.emplace_back(e[0], e[1]);
+      pairs.emplace_back(e[1], e[2]);
+      pairs.emplace_back(e[2], e[0]);
+    }
+    pattern.build(n, pairs);
+    system.reset(pattern);
+    dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    std::mt19937 wobble(seed + 1000);
+    for (const auto& e : elements) {
+      Eigen::Matrix<double, 9, 9> A;
+      for (int i = 0; i < 81; ++i) A.data()[i] = u(rng) + perturbation * u(wobble);
+      const Eigen::Matrix<double, 9, 9> K = A * A.transpose();
+      system.add_element<3>(e, element_block_ids<3>(pattern, e), K, stiffness);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          dense.block<3, 3>(3 * e[a], 3 * e[b]) += stiffness * K.block<3, 3>(3 * a, 3 * b);
+    }
+    for (int i = 0; i < n; ++i) {
+      system.add_diagonal(i, mass * Mat3::Identity());
+      dense.block<3, 3>(3 * i, 3 * i) += mass * Mat3::Identity();
+    }
+    system.rhs = VecX::NullaryExpr(3 * n, [&] { return u(rng); });
+  }
+};
+
+SolverSettings iterative_settings(double tolerance, int max_iterations) {
+  SolverSettings s;
+  s.pcg_min_nodes = 0;
+  s.pcg_tolerance = tolerance;
+  s.pcg_max_iterations = max_iterations;
+  return s;
+}
+
+TEST(CholeskySolverPcg, SmallSystemsAreFactorisedAtEverySolve) {
+  RandomSystem a(40, 3, 1.0, 1.0);
+  CholeskySolver solver;  // default settings: 40 nodes is far below pcg_min_nodes
+  VecX x;
+  SolveReport report;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(solver.solve_system(a.system, x, report));
+    EXPECT_TRUE(report.factorized);
+    EXPECT_EQ(report.iterations, 0);
+    EXPECT_LT(report.residual, 1e-12);
+    EXPECT_LT((a.dense * x - a.system.rhs).norm(), 1e-12 * a.system.rhs.norm());
+  }
+  EXPECT_EQ(solver.factorizations(), 3);
+}
+
+TEST(CholeskySolverPcg, ConvergesWithAKeptFactorisationOfANearbyMatrix) {
+  CholeskySolver solver;
+  solver.set_settings(iterative_settings(1e-10, 30));
+  RandomSystem first(60, 7, 1.0, 0.1);
+  VecX x;
+  SolveReport report;
+  ASSERT_TRUE(solver.solve_system(first.system, x, report));
+  EXPECT_TRUE(report.factorized);
+  // The same matrix again: the kept factor is exact, one iteration.
+  ASSERT_TRUE(solver.solve_system(first.system, x, report));
+  EXPECT_FALSE(report.factorized);
+  EXPECT_EQ(report.iterations, 1);
+  // A matrix 2% away (another pattern object, the same size): conjugate gradients to the tolerance, and the
+  // answer is the direct solve's to that precision.
+  RandomSystem nearby(60, 7, 1.0, 0.1, 0.02);
+  ASSERT_TRUE(solver.solve_system(nearby.system, x, report));
+  EXPECT_FALSE(report.factorized);
+  EXPECT_GT(report.iterations, 1);
+  EXPECT_LE(report.iterations, 30);
+  EXPECT_LE(report.residual, 1e-10 * 1.0001);
+  const VecX exact = nearby.dense.llt().solve(nearby.system.rhs);
+  EXPECT_LT((x - exact).norm(), 1e-6 * exact.norm());
+  EXPECT_EQ(solver.factorizations(), 1);
+}
+
+TEST(CholeskySolverPcg, AStaleFactorisationIsRefreshed) {
+  CholeskySolver solver;
+  solver.set_settings(iterative_settings(1e-8, 4));
+  RandomSystem soft(60, 11, 1.0, 0.01);
+  VecX x;
+  SolveReport report;
+  ASSERT_TRUE(solver.solve_system(soft.system, x, report));
+  // Far from the kept factor (other element matrices, 100x stiffer): 4 iterations do not reach 1e-8, so the solve
+  // factorises afresh and is direct.
+  RandomSystem stiff(60, 12, 100.0, 0.01);
+  ASSERT_TRUE(solver.solve_system(stiff.system, x, report));
+  EXPECT_TRUE(report.factorized);
+  EXPECT_EQ(report.iterations, 4);
+  EXPECT_LT(report.residual, 1e-12);
+  EXPECT_LT((stiff.dense * x - stiff.system.rhs).norm(), 1e-12 * stiff.system.rhs.norm());
+  EXPECT_EQ(solver.factorizations(), 2);
+  // The refreshed factor now serves the stiff matrix at once; refresh() forces a factorisation.
+  ASSERT_TRUE(solver.solve_system(stiff.system, x, report));
+  EXPECT_FALSE(report.factorized);
+  solver.refresh();
+  ASSERT_TRUE(solver.solve_system(stiff.system, x, report));
+  EXPECT_TRUE(report.factorized);
+  // Another size: factorised.
+  RandomSystem other(50, 13, 1.0, 1.0);
+  ASSERT_TRUE(solver.solve_system(other.system, x, report));
+  EXPECT_TRUE(report.factorized);
+}
+
+TEST(CholeskySolverPcg, AnIndefiniteMatrixStillFailsUnderTheIteration) {
+  CholeskySolver solver;
+  solver.set_settings(iterative_settings(1e-10, 20));
+  RandomSystem good(40, 17, 1.0, 1.0);
+  VecX x;
+  SolveReport report;
+  ASSERT_TRUE(solver.solve_system(good.system, x, report));
+  RandomSystem bad(40, 17, 1.0, 1.0);
+  for (int i = 0; i < 40; ++i) bad.system.add_diagonal(i, -1e3 * Mat3::Identity());
+  EXPECT_FALSE(solver.solve_system(bad.system, x, report));
+}
+
 }  // namespace
 }  // namespace arcsim

@@ -1,8 +1,12 @@
 // Time per implicit step on flat sheets of 1k to 64k faces, split into assembly, factorisation and solve.
-// Run with `make bench`; docs/benchmarks.md records the figures.
+// Run with `make bench`; docs/benchmarks.md records the figures. ARCSIM_BENCH_PCG_TOLERANCE and
+// ARCSIM_BENCH_PCG_MAX_ITERATIONS override the solver settings (for measuring them).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 
 #include "physics/cloth_physics.hpp"
 #include "support/mesh_factory.hpp"
@@ -39,21 +43,38 @@ struct BenchSheet {
   }
 };
 
-void BM_ImplicitStep(benchmark::State& state) {
+// The solver's default settings (physics/solver_settings.hpp); `direct` factorises at every step (the solver
+// before 2026-12-05, and what systems below pcg_min_nodes get).
+void run_implicit_steps(benchmark::State& state, bool direct) {
   BenchSheet sheet(static_cast<int>(state.range(0)));
+  SolverSettings settings;
+  if (direct) settings.pcg_min_nodes = std::numeric_limits<int>::max();
+  if (const char* tolerance = std::getenv("ARCSIM_BENCH_PCG_TOLERANCE")) settings.pcg_tolerance = std::atof(tolerance);
+  if (const char* iterations = std::getenv("ARCSIM_BENCH_PCG_MAX_ITERATIONS"))
+    settings.pcg_max_iterations = std::atoi(iterations);
+  sheet.solver.set_settings(settings);
   const double dt = 1e-3;
   implicit_euler_step(sheet.mesh, sheet.cache, sheet.solver, sheet.loads, dt);  // symbolic analysis, once
   StepTiming timing;
   for (auto _ : state) implicit_euler_step(sheet.mesh, sheet.cache, sheet.solver, sheet.loads, dt, &timing);
   const double steps = static_cast<double>(state.iterations());
+  double max_residual = 0;
+  for (double r : timing.residuals) max_residual = std::max(max_residual, r);
   state.counters["faces"] = static_cast<double>(sheet.mesh.faces.size());
   state.counters["assembly_ms"] = 1e3 * timing.assembly / steps;
   state.counters["factor_ms"] = 1e3 * timing.factorization / steps;
   state.counters["solve_ms"] = 1e3 * timing.solve / steps;
   state.counters["assembly_share"] = timing.assembly / (timing.assembly + timing.factorization + timing.solve);
+  state.counters["factorizations"] = timing.factorizations / steps;  // per step
+  state.counters["pcg_iterations"] = timing.iterations / steps;      // per step
+  state.counters["max_residual"] = max_residual;
 }
+
+void BM_ImplicitStep(benchmark::State& state) { run_implicit_steps(state, false); }
+void BM_ImplicitStepDirect(benchmark::State& state) { run_implicit_steps(state, true); }
 BENCHMARK(BM_ImplicitStep)->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
+BENCHMARK(BM_ImplicitStepDirect)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
 }  // namespace arcsim
