@@ -100,9 +100,11 @@ TEST(StressGlassSlow, PlateThrownAtAFloorHoldsAtTwoFiveAndTenTimesArcsimsStep) {
 // step's collision response projects the edge nodes by v dt = 3.8 mm and strains the glass over many rings
 // (sigma+ up to 30 tau, 232 breaking nodes); fracture's virtual update in the default 3-ring zone cannot relax a
 // strain its fixed support holds too, and the plate shatters into hundreds of pieces (at 1e-3 s steps it lands
-// whole). Letting the zone grow while its support is stressed past half the toughness relaxes the artefact: the
-// plate lands whole at 5 ms too.
-TEST(StressGlassSlow, ZonesGrowingToACalmSupportKeepAPlateLandingAtFiveMillisecondStepsWhole) {
+// whole). Letting the zone grow while its support is stressed past half the toughness relaxes most of the
+// artefact, not all of it: once the zone is the whole plate, the strain the floor's contacts hold remains (on
+// some machines 0 cracks, on others 7 at sigma+ = 31 tau with the whole plate in the zone; the trajectory before
+// the landing rounds differently between CPUs). Bounding the collision correction (the next test) is the cure.
+TEST(StressGlassSlow, ZonesGrowingToACalmSupportRelaxMostOfAPlateLandingAtFiveMillisecondSteps) {
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
   TempDir dir;
@@ -116,8 +118,10 @@ TEST(StressGlassSlow, ZonesGrowingToACalmSupportKeepAPlateLandingAtFiveMilliseco
     EXPECT_EQ(check_mesh(sim.cloths[0].mesh), "");
     return cracks;
   };
-  EXPECT_EQ(cracks_with(R"({"max_zone_rings": 16, "support_stress": 0.5})"), 0);
-  EXPECT_GT(cracks_with("{}"), 100) << "the default zone no longer shatters the plate: the case proves nothing";
+  const int grown = cracks_with(R"({"max_zone_rings": 16, "support_stress": 0.5})");
+  const int fixed_zone = cracks_with("{}");
+  EXPECT_GT(fixed_zone, 100) << "the default zone no longer shatters the plate: the case proves nothing";
+  EXPECT_LT(20 * grown, fixed_zone) << grown << " cracks with zone growth against " << fixed_zone << " without";
 }
 
 // The cause of that shattering, bounded directly: adaptive time stepping with max_correction = the repulsion
