@@ -23,7 +23,7 @@ meshes/geosphereF.obj   unit geodesic sphere (icosahedron faces cut F x F), 20 F
                         ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 16, 20: static meshes to
                         match an adaptive run's mean face count, conf/paper-ornament*.json).
 meshes/hemisphere.obj   unit hemisphere z >= 0 (octahedron's upper faces cut 8 x 8), 256 faces; rim label 1
-                        (docs/repro/paper-dome-draft.json).
+                        (conf/paper-dome.json).
 meshes/pane.obj         1 m x 1 m, 16 x 16 cells, 512 faces; every border node label 1 (conf/paper-window.json).
 meshes/box_frame.obj     a square tube 20 cm wide and 20 cm high (z up, open at top and bottom, centred on the z
                         axis, bottom at z = 0): the box frame of the metal-and-glass scene. 1 cm cells, 80 around
