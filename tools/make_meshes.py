@@ -15,7 +15,7 @@ meshes/square_top_slit.obj  the same turned a quarter turn: the slit runs down f
                         (tip at (0.5, 0.8)); grips along the top two rows left (x in [0.25, 0.4], label 1) and
                         right (x in [0.6, 0.75], label 2) of it (paper tearing, conf/paper-tearing.json).
 meshes/square_clamped.obj  the square (10 x 10 cells, 121 nodes, 200 faces) with its 40 border nodes labelled 1
-                        (clamped all round: docs/repro/paper-variety-draft.json).
+                        (clamped all round: conf/paper-variety.json).
 meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
 meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
                         320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
@@ -177,7 +177,7 @@ def square_top_slit():
 
 def square_clamped():
     """meshes/square_clamped.obj: the 10 x 10 square with every border node labelled 1 (a sheet clamped all round:
-    the material-variety impacts, docs/repro/paper-variety-draft.json)."""
+    the material-variety impacts, conf/paper-variety.json)."""
     nodes, faces, node = grid(1.0, 1.0, 10, 10)
     labels = {node(i, j): 1 for j in range(11) for i in range(11) if i in (0, 10) or j in (0, 10)}
     return nodes, faces, labels
