@@ -18,6 +18,7 @@
 #include "io/scene_parser.hpp"
 #include "stress/repository.hpp"
 #include "support/files.hpp"
+#include "mesh/pieces.hpp"
 #include "mesh/validate.hpp"
 #include "sim/simulation.hpp"
 
@@ -188,6 +189,45 @@ TEST(StressGlassSlowCheck, PlateShatteringAtFiveMillisecondStepsEndsWithAdaptive
   int faces = 0;
   for (const Face& f : sim.cloths[0].mesh.faces) faces += !f.dead;
   std::printf("glass plate at 5 ms: %d retries, finest level %d, %d faces at the end\n", retries, finest, faces);
+}
+
+
+// "A sheet torn into hundreds of pieces": the plate dropped 3 cm with 5 ms steps as above, at a quarter of the
+// toughness (5e6 Pa), fixed steps, to 0.12 s (docs/repro/glass-plate-shards.json with "toughness": 5e6 and
+// "max_cracks": 2000). It shatters on landing (step 17) and again (step 21) into about 150 pieces, many of a few
+// faces, lying pressed against each other on the floor. What holds: every frame valid, finite, above the floor,
+// free of crossing triangles. (At 1e7 Pa the same plate gets 191 crossing pairs at step 21: crack lips left
+// coincident, docs/stability.md 2026-12-05; not a test until that is fixed.)
+TEST(StressShardsSlowCheck, PlateShatteredIntoAHundredPiecesStaysValidAndIntersectionFree) {
+  const fs::path root = repository_root("meshes/square.obj");
+  ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
+  TempDir dir;
+  std::string scene = dropped_plate_scene(root, "5e-3", "0.12", "");
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{R"("toughness": 2e7)", R"("toughness": 5e6)"},
+                                 {R"("max_cracks": 400)", R"("max_cracks": 2000)"}})
+    scene.replace(scene.find(from), from.size(), to);
+  Simulation sim = load_scene_text(dir, scene);
+  double lowest = 0;
+  int crossing = 0, most_pieces = 0;
+  std::string invalid, failure;
+  try {
+    while (!sim.finished()) {
+      sim.advance_frame();
+      for (const Node& n : sim.cloths[0].mesh.nodes) lowest = std::min(lowest, n.x.z());
+      crossing += count_intersecting_pairs(sim);
+      most_pieces = std::max(most_pieces, static_cast<int>(mesh_pieces(sim.cloths[0].mesh).size()));
+      if (invalid.empty()) invalid = check_mesh(sim.cloths[0].mesh);
+      if (invalid.empty()) invalid = sim.nonfinite_state();
+    }
+  } catch (const NumericalError& e) {
+    failure = e.what();
+  }
+  std::printf("[ result ] shards: up to %d pieces, %d crossing pairs over the frames\n", most_pieces, crossing);
+  EXPECT_EQ(failure, "");
+  EXPECT_EQ(invalid, "");
+  EXPECT_GE(lowest, -1e-4) << "a node went through the floor";
+  EXPECT_EQ(crossing, 0);
+  EXPECT_GT(most_pieces, 100) << "it no longer shatters into hundreds of pieces: the case proves nothing";
 }
 
 }  // namespace
