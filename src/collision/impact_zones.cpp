@@ -12,16 +12,49 @@ namespace {
 // Below this sine of the angle between two edges, an edge-edge impact takes the second edge's surface normal.
 constexpr double kNearParallelSine = 0.1;
 
+// For an edge-edge pair of two borders (one face each) whose faces lie on opposite sides, a crack's two lips
+// facing each other (or two shards edge to edge): the direction from the second edge's face toward the
+// first's, across the edges (the normalised difference of the two faces' inward directions), if the edges
+// started apart along it or overlapping by less than `reach`; zero otherwise (they are stacked: one lip slid
+// over the other's face).
+Vec3 facing_borders_normal(const ContactGeometry& g, const PrimitivePair& p, const std::array<int, 4>& nodes, double t,
+                           const Vec3& start_gap, double reach) {
+  if (!g.is_boundary_edge(p.a) || !g.is_boundary_edge(p.b)) return Vec3::Zero();
+  auto at = [&](int n) { return Vec3(g.x0[n] + t * (g.x1[n] - g.x0[n])); };
+  // The unit direction from edge (n0, n1) into its face, across the edge.
+  auto inward = [&](int edge, int n0, int n1) {
+    const int f = g.edge_faces[edge][0] != kNone ? g.edge_faces[edge][0] : g.edge_faces[edge][1];
+    Vec3 centroid = Vec3::Zero();
+    for (int n : g.faces[f]) centroid += at(n) / 3;
+    const Vec3 along = (at(n1) - at(n0)).normalized();
+    const Vec3 in = centroid - 0.5 * (at(n0) + at(n1));
+    const Vec3 across = in - in.dot(along) * along;
+    return across.norm() > 0 ? Vec3(across.normalized()) : Vec3(Vec3::Zero());
+  };
+  const Vec3 in_a = inward(p.a, nodes[0], nodes[1]), in_b = inward(p.b, nodes[2], nodes[3]);
+  if (!(in_a.dot(in_b) < -0.5)) return Vec3::Zero();
+  const Vec3 normal = (in_a - in_b).normalized();
+  if (!(normal.dot(start_gap) > -reach)) return Vec3::Zero();
+  return normal;
+}
+
 // For an edge-edge impact of nearly parallel edges (sine below kNearParallelSine), the normal of the surface
 // at the second edge (the normalised sum of its faces' normals, at the impact's time), on the side the first
-// edge came from; `normal` unchanged where that surface normal is undefined or leaves the side unclear.
+// edge came from; `normal` unchanged where that surface normal is undefined or leaves the side unclear. Two
+// facing borders take facing_borders_normal instead.
 // WHY: the two edges' cross product (the plane normal ccd.cpp uses) turns with the tiny angle between nearly
 // parallel edges, so it can lie in the surface: a sheet pressed onto a sphere had its edge and a sphere edge
 // side by side with normals pointing +x and -x at one node, and the impact zone met both only by moving the
 // node 1 mm through the sheet's plane (26 J of collision work in one 1 ms step of
 // conf/metal-crumple-remesh.json). The surface normal says which way is out.
+// WHY facing borders: a crack's two lips, twisted against each other by micrometres, have one lip above the
+// other's line at one end and below it at the other, so the side read off the start gap at the contact point
+// flips along them. The impacts of one lip pair found at two points then asked for opposite normals, the zone
+// of their 4 nodes was ill-conditioned (25-280x) at every substep, and pushing lips millimetres apart strained
+// the glass to 1e3-1e8 times its toughness (conf/paper-metal-glass.json on an AMD EPYC guest). Facing lips
+// are apart across their edges, within the sheet, whichever way they twist.
 Vec3 near_parallel_edge_normal(const ContactGeometry& g, const PrimitivePair& p, const std::array<int, 4>& nodes,
-                               const std::array<double, 4>& weights, double t, const Vec3& normal) {
+                               const std::array<double, 4>& weights, double t, double reach, const Vec3& normal) {
   auto at = [&](int n) { return Vec3(g.x0[n] + t * (g.x1[n] - g.x0[n])); };
   const Vec3 a = at(nodes[1]) - at(nodes[0]), b = at(nodes[3]) - at(nodes[2]);
   const double lengths = a.norm() * b.norm();
@@ -37,6 +70,8 @@ Vec3 near_parallel_edge_normal(const ContactGeometry& g, const PrimitivePair& p,
   surface.normalize();
   Vec3 start_gap = Vec3::Zero();
   for (int i = 0; i < 4; ++i) start_gap += weights[i] * g.x0[nodes[i]];
+  const Vec3 facing = facing_borders_normal(g, p, nodes, t, start_gap, reach);
+  if (facing.norm() > 0) return facing;
   const double start_side = surface.dot(start_gap), contact_side = surface.dot(normal);
   if (std::abs(start_side) > 0.1 * start_gap.norm() && start_side != 0) return start_side > 0 ? surface : -surface;
   if (std::abs(contact_side) > 0.1) return contact_side > 0 ? surface : -surface;
@@ -101,7 +136,7 @@ std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cac
     r.normal = hit->contact.normal;
     r.time = hit->time;
     if (p.kind == PairKind::kEdgeEdge) {
-      r.normal = near_parallel_edge_normal(g, p, nodes, r.weights, r.time, r.normal);
+      r.normal = near_parallel_edge_normal(g, p, nodes, r.weights, r.time, params.thickness, r.normal);
       r.normal = end_to_end_normal(g, nodes, r.weights, r.time, params.thickness, r.normal);
     }
     found[k] = r;

@@ -297,6 +297,41 @@ TEST(ImpactZones, EdgesMeetingEndToEndTakeTheDirectionBetweenTheirEnds) {
   EXPECT_EQ(checked, 1) << "the two edges' impact was not found";
 }
 
+// Two lips of a crack in the plane z = 0, a few micrometres apart across their edges (along y) and twisted
+// against each other by micrometres out of the plane: lip A's edge is above lip B's line at one end and below it
+// at the other. Moving A onto B, the impact between the two border edges must push them apart across the
+// edges (+y, from B's face toward A's), wherever along the lips the contact falls. Before the rule the normal
+// was the sheet's normal, up where the contact fell at A's high end and down at its low end: the impacts of one
+// lip pair found in two rounds contradicted each other, and the zone of their 4 nodes was ill-conditioned
+// (conf/paper-metal-glass.json, step 110 of a run with stiff contact on an AMD EPYC guest).
+TEST(ImpactZones, TwistedCrackLipsArePushedApartAcrossTheirEdges) {
+  constexpr double kLength = 1e-2, kGap = 5e-6, kTwist = 3e-6, kSkew = 2e-6;
+  for (const bool near_high_end : {true, false}) {
+    // Lip A: its edge from (0, ., +twist) to (L, ., -twist), its face toward +y; nearer B at one end.
+    const double y0 = near_high_end ? kGap : kGap + kSkew, y1 = near_high_end ? kGap + kSkew : kGap;
+    const std::vector<Vec3> x0{{0, y0, kTwist},       {kLength, y1, -kTwist},     {0.5 * kLength, 0.5 * kLength, 0},
+                               {-0.5 * kLength, 0, 0}, {1.5 * kLength, 0, 0},      {0.5 * kLength, -0.5 * kLength, 0}};
+    Mesh m = Mesh::from_triangles(x0, x0, {0, 1, 2, 3, 4, 5}, {{0, 1, 2}, {3, 5, 4}});
+    for (Node& n : m.nodes) n.mass = 1e-5;
+    // A moves onto B's line within the step.
+    for (int i = 0; i < 3; ++i) m.nodes[i].x.y() -= kGap + kSkew + 1e-6;
+    ContactGeometry g;
+    build_contact_geometry({{&m, true}}, ContactStage::kAfterStep, 1e-3, g);
+    BvhCache cache;
+    int checked = 0;
+    for (const ImpactRecord& r : detect_impacts(g, cache, params())) {
+      if (r.kind != static_cast<int>(PairKind::kEdgeEdge)) continue;
+      const std::array<int, 4> lips{0, 1, 3, 4};
+      if (!std::is_permutation(r.nodes.begin(), r.nodes.end(), lips.begin())) continue;
+      ++checked;
+      const double toward_a = r.nodes[0] <= 1 ? 1 : -1;  // the normal points toward the first edge
+      EXPECT_GT(toward_a * r.normal.y(), 0.999) << (near_high_end ? "high" : "low") << " end: normal "
+                                                     << r.normal.transpose();
+    }
+    EXPECT_EQ(checked, 1) << "the lips' edge-edge impact was not found";
+  }
+}
+
 TEST(ImpactZones, InfeasibleZoneFallsBackWithWarning) {
   // A small sheet between two static plates only half a projection gap apart falls through the lower one: no
   // position satisfies both gaps, so the zone moves rigidly (still colliding) and then stays at x0.
