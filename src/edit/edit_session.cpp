@@ -489,6 +489,27 @@ bool EditSession::move_node(int node, const Vec3& displacement, const NodeMoveOp
   return true;
 }
 
+bool EditSession::move_allowed(int node, const std::vector<int>& faces, const Vec3& displacement,
+                               const NodeMoveOptions& options) const {
+  if (!guard_) return true;
+  const Vec3 from = m_.nodes[node].x, to = from + displacement;
+  std::vector<GuardTriangle> before, after;
+  std::vector<GuardSweep> sweeps;
+  for (int f : faces) {
+    const int c = m_.corner_of_node(f, node);
+    if (c == kNone) continue;
+    const int b0 = m_.face_node(f, (c + 1) % 3), b1 = m_.face_node(f, (c + 2) % 3);
+    const Vec3 &x0 = m_.nodes[b0].x, &x1 = m_.nodes[b1].x;
+    before.push_back({{from, x0, x1}, {node, b0, b1}});
+    after.push_back({{to, x0, x1}, {node, b0, b1}});
+    sweeps.push_back({{from, to, x0, x1}, {node, node, b0, b1}});
+  }
+  std::vector<int> exempt = options.exempt_faces;
+  std::sort(exempt.begin(), exempt.end());
+  if (!options.require_clearance) return guard_->sweep_is_clear(sweeps, exempt);
+  return guard_->allows(before, after, sweeps, exempt);
+}
+
 // The stress-free part of a node move: its elastic faces' rest shape moves with it (a cut, not a strain), and
 // each such face keeps its mass (thickness times rest area). WHY not a plastic stretch Fp (what it was): the
 // remesher averages the Fp of the faces an edit replaces, and averaged stretches are a strain an elastic sheet

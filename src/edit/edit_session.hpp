@@ -147,6 +147,13 @@ class EditSession {
   // Moves a node (and its start-of-step position x0) by `displacement` (m) through the world guard; true if
   // the move was kept. For small moves an edit needs (fracture: the lips of a new crack set apart).
   bool move_node(int node, const Vec3& displacement, const NodeMoveOptions& options = {});
+  // Whether the guard would keep a move of `node` by `displacement` that only `faces` (some of the node's faces)
+  // follow, checked as move_node checks it; changes nothing. For an edit that must know before it splits a node
+  // whether the moves it makes after the split will be kept (crack opening: a split whose lips cannot be set
+  // apart leaves coincident lips, which collision handling cannot separate). The node's other faces are not
+  // checked (they touch it). True without a guard.
+  bool move_allowed(int node, const std::vector<int>& faces, const Vec3& displacement,
+                    const NodeMoveOptions& options = {}) const;
 
   void add_observer(EditObserver* observer) { observers_.push_back(observer); }
 

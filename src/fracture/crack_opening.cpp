@@ -201,47 +201,123 @@ int piece_faces(const Mesh& m, int start, const std::vector<int>& cut, int limit
   return static_cast<int>(seen.size());
 }
 
-// Moves a node of a new crack by `distance` (m) away from the other side(s) of the split, `twins` (the split
-// node and its copies): along its own faces' centroid minus the centroid of all the copies' faces, within its
-// faces' mean world plane. The guard does not check the move against the faces of `split` (every node the
-// opening split, and their copies), which it touches by construction: they start coincident with its own.
-void set_lip_apart(EditSession& session, int node, double distance, const std::vector<int>& twins,
-                   const std::vector<int>& split) {
-  const Mesh& m = session.mesh();
+// The world direction (unit) in which the lip made of faces `own` moves away from the crack: their centroid minus
+// the centroid of `all` (the faces of every side of the split node), within their mean world plane. Zero if it
+// has none.
+Vec3 lip_direction(const Mesh& m, const std::vector<int>& own, const std::vector<int>& all) {
+  if (own.empty() || all.empty()) return Vec3::Zero();
   auto centroid_of = [&](const std::vector<int>& faces) {
     Vec3 c = Vec3::Zero();
     for (int f : faces)
       for (int i = 0; i < 3; ++i) c += m.nodes[m.face_node(f, i)].x / 3;
     return Vec3(c / static_cast<double>(faces.size()));
   };
+  Vec3 normal = Vec3::Zero();
+  for (int f : own) normal += m.world_normal(f);
+  Vec3 d = centroid_of(own) - centroid_of(all);
+  if (normal.norm() > 0) d -= d.dot(normal.normalized()) * normal.normalized();
+  return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
+}
+
+// The faces of `from` not in `own`.
+std::vector<int> faces_besides(const std::vector<int>& from, const std::vector<int>& own) {
+  std::vector<int> out;
+  for (int f : from)
+    if (std::find(own.begin(), own.end(), f) == own.end()) out.push_back(f);
+  return out;
+}
+
+// Moves a node of a new crack by `distance` (m) away from the other side(s) of the split, `twins` (the split
+// node and its copies): along lip_direction of its own faces. The guard does not check the move against the
+// faces of `split` (every node the opening split, and their copies), which it touches by construction: they
+// start coincident with its own. True if the move was kept.
+bool set_lip_apart(EditSession& session, int node, double distance, const std::vector<int>& twins,
+                   const std::vector<int>& split) {
+  const Mesh& m = session.mesh();
   const std::vector<int> own = m.node_faces(node);
-  std::vector<int> all, exempt;
+  std::vector<int> all, around;
   for (int t : twins) {
     const std::vector<int> faces = m.node_faces(t);
     all.insert(all.end(), faces.begin(), faces.end());
   }
   for (int t : split) {
-    for (int f : m.node_faces(t))
-      if (std::find(own.begin(), own.end(), f) == own.end()) exempt.push_back(f);
+    const std::vector<int> faces = m.node_faces(t);
+    around.insert(around.end(), faces.begin(), faces.end());
   }
-  if (own.empty() || all.empty()) return;
-  Vec3 normal = Vec3::Zero();
-  for (int f : own) normal += m.world_normal(f);
-  Vec3 d = centroid_of(own) - centroid_of(all);
-  if (normal.norm() > 0) d -= d.dot(normal.normalized()) * normal.normalized();
-  if (!(d.norm() > 0)) return;
+  const Vec3 d = lip_direction(m, own, all);
+  if (!(d.norm() > 0)) return false;
   // The guard's clearance first. A lip next to the lip of an earlier crack (the same node split twice in a
   // step, paper-tearing.json step 1128) cannot keep it: those lips are only a lip gap apart. Coincident twins
   // are worse than lips closer than the clearance, so then only sweeping through a surface is ruled out.
   // The gap is taken up plastically by the lip's faces (NodeMoveOptions::stress_free): it is room for the
   // collision stage, not a strain of the material.
-  const Vec3 move = distance * d.normalized();
+  const Vec3 move = distance * d;
   NodeMoveOptions options;
-  options.exempt_faces = std::move(exempt);
+  options.exempt_faces = faces_besides(around, own);
   options.stress_free = true;
-  if (session.move_node(node, move, options)) return;
+  if (session.move_node(node, move, options)) return true;
   options.require_clearance = false;
-  session.move_node(node, move, options);
+  return session.move_node(node, move, options);
+}
+
+// The faces around `node` in the groups a split along the `cut` edges makes (its sides: the lips of the crack),
+// joined across the node's interior edges that are not cut.
+std::vector<std::vector<int>> sides_of(const Mesh& m, int node, const std::vector<int>& cut) {
+  const std::vector<int> faces = m.node_faces(node);
+  std::vector<int> group(faces.size(), -1);
+  std::vector<std::vector<int>> sides;
+  for (size_t start = 0; start < faces.size(); ++start) {
+    if (group[start] >= 0) continue;
+    const int g = static_cast<int>(sides.size());
+    sides.emplace_back();
+    std::vector<size_t> stack{start};
+    group[start] = g;
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      sides[g].push_back(faces[i]);
+      for (int e : m.faces[faces[i]].e) {
+        const Edge& edge = m.edges[e];
+        if ((edge.n[0] != node && edge.n[1] != node) || edge.is_boundary() ||
+            std::find(cut.begin(), cut.end(), e) != cut.end())
+          continue;
+        const int other = m.other_face(e, faces[i]);
+        for (size_t j = 0; j < faces.size(); ++j)
+          if (faces[j] == other && group[j] < 0) group[j] = g, stack.push_back(j);
+      }
+    }
+  }
+  return sides;
+}
+
+// Whether every lip of the split open_crack is about to make (`node` along `crack_edges`, with the far ends in
+// `split_far_ends`) can be set `distance` apart from its twin, checked before the split as set_lip_apart's
+// weaker try checks it after. WHY: a lip whose move the guard refuses (its sweep meets the lips of an earlier
+// crack of the same pass, often coincident twins themselves) stays coincident with its twin; once a later edit
+// removes the node they share, their faces cross, and collision handling has no normal to separate them
+// (docs/repro/glass-plate-shards-coincident-lips.json: 66 such lips in one step, 191 crossing pairs).
+bool lips_can_part(const EditSession& session, int node, const std::vector<int>& crack_edges,
+                   const std::vector<int>& split_far_ends, double distance) {
+  const Mesh& m = session.mesh();
+  std::vector<int> around = m.node_faces(node);
+  for (int far : split_far_ends) {
+    const std::vector<int> faces = m.node_faces(far);
+    around.insert(around.end(), faces.begin(), faces.end());
+  }
+  std::vector<int> splitting{node};
+  splitting.insert(splitting.end(), split_far_ends.begin(), split_far_ends.end());
+  for (int n : splitting) {
+    const std::vector<int> all = m.node_faces(n);
+    for (const std::vector<int>& own : sides_of(m, n, crack_edges)) {
+      const Vec3 d = lip_direction(m, own, all);
+      if (!(d.norm() > 0)) return false;
+      NodeMoveOptions options;
+      options.exempt_faces = faces_besides(around, own);
+      options.require_clearance = false;
+      if (!session.move_allowed(n, own, distance * d, options)) return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -283,6 +359,8 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
     for (int f : m.node_faces(node))
       if (piece_faces(m, f, out.crack_edges, options.min_piece_faces) < options.min_piece_faces)
         return refuse(out, "the crack would cut off a piece of fewer than min_piece_faces faces");
+  if (options.lip_gap > 0 && !lips_can_part(session, node, out.crack_edges, split_far_ends, 0.5 * options.lip_gap))
+    return refuse(out, "the lips could not be set apart (the world guard refuses their move)");
   const EditResult r = session.split_node(node, out.crack_edges);
   if (!r.ok) return refuse(out, "the edit session refused the node split");
   out.mesh_changed = true;

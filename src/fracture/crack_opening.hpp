@@ -13,7 +13,10 @@
 // Mass and linear momentum are conserved exactly (up to round-off): a split edge's new node interpolates the
 // velocity linearly at t, which is what the lumped masses redistribute; a node split copies the velocity.
 // Refused when the cut would need a face or edge smaller than the sliver limits, follow an edge that is already
-// a border, put both rays on one edge, or the session refuses an edit; the reason is returned. Every check that
+// a border, put both rays on one edge, when a lip of the split could not be set lip_gap apart (checked through
+// the session's world guard before the node split: lips left coincident have no contact normal, and their faces
+// cross once a later edit removes the node they share), or the session refuses an edit; the reason is returned.
+// A refused node is not tried again in the same fracture pass (fracture_step.hpp); the next step may retry it. Every check that
 // needs no edit runs on all rays before the first edit, so a refusal normally changes nothing. Only when the
 // session refuses a later step after the first ray's edge split succeeded (or the second ray's plan changes
 // because of that split) does a refused opening leave that split in place: mesh_changed says so, and the mesh

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "collision/intersections.hpp"
 #include "edit/edit_session.hpp"
 #include "fracture/crack_opening.hpp"
 #include "mesh/mesh_fixtures.hpp"
@@ -171,6 +172,9 @@ struct GuardedGrid {
   CrackOpeningOptions crack = options_with_size(0.2);
 };
 
+// Pairs of the sheet's faces that share a point without sharing a node (collision/intersections.hpp).
+size_t crossing_pairs(const Mesh& mesh) { return intersecting_pairs({&mesh}, {}).size(); }
+
 Material elastic_aluminium() {
   Material m = testing::aluminium_sheet(1.0);
   m.yield_curv = kInfinity;
@@ -196,6 +200,46 @@ TEST(CrackOpening, LipsStartApartWithTheWorldGuardOn) {
     // Across the crack (it runs along y); a border node's copies move into their own corners, at 45 degrees.
     EXPECT_GT(std::abs(gap.x()), (border ? 0.7 : 0.999) * g.crack.lip_gap);
     EXPECT_EQ(check_mesh(mesh), "");
+  }
+}
+
+// An opening whose lips cannot be set apart is refused before the node split (docs/stability.md, 2026-12-05
+// evening). A thin obstacle (a blade, edge-on) stands in the sheet along the crack's line, so the guard refuses
+// every move of either lip (each lip's sweep meets it). Before the fix the node was split anyway and its two
+// halves stayed coincident: faces of the two lips touch at that point without sharing a node, a crossing that
+// collision handling cannot separate (no normal); 191 such pairs, from lip moves the guard refused because they
+// met an earlier crack's lips, stopped docs/repro/glass-plate-shards-coincident-lips.json.
+TEST(CrackOpening, OpeningWhoseLipsCannotPartIsRefusedBeforeTheSplit) {
+  const Material material = elastic_aluminium();
+  const int node = test::grid_node(6, 3, 2);  // (0.6, 0.4): the crack runs along x = 0.6
+  // The blade: a triangle in the plane x = 0.6, through the node, 1 cm above and below the sheet.
+  const Mesh blade = Mesh::from_triangles({Vec3(0.6, 0.3, -0.01), Vec3(0.6, 0.3, 0.01), Vec3(0.6, 0.5, 0)},
+                                          {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, {0, 1, 2}, {{0, 1, 2}});
+  for (const bool blocked : {true, false}) {
+    Mesh mesh = make_grid(6, 4, 1.2, 0.8, Diagonal::kAlternating);
+    const std::vector<Material> materials{material};
+    for (Face& f : mesh.faces) f.thickness = material.thickness;
+    EditSessionOptions o;
+    o.world_clearance = 1e-6;
+    if (blocked) o.obstacles.push_back(&blade);
+    EditSession session(mesh, materials, o);
+    CrackOpeningOptions crack = options_with_size(0.2);
+    crack.lip_gap = 2e-5;
+    const long nodes_before = static_cast<long>(mesh.nodes.size());
+    const CrackOpening opening = open_crack(
+        session, node, {ray_along(mesh, node, Vec3(0, -1, 0)), ray_along(mesh, node, Vec3(0, 1, 0))}, crack);
+    EXPECT_EQ(check_mesh(mesh), "");
+    EXPECT_EQ(crossing_pairs(mesh), 0u) << (blocked ? "coincident lips left by a refused lip move" : "free");
+    if (blocked) {
+      EXPECT_FALSE(opening.ok);
+      EXPECT_NE(opening.refused.find("lips could not be set apart"), std::string::npos) << opening.refused;
+      EXPECT_EQ(static_cast<long>(mesh.nodes.size()), nodes_before) << "no node was split";
+    } else {
+      ASSERT_TRUE(opening.ok) << opening.refused;  // the same crack without the blade opens
+      ASSERT_EQ(opening.nodes.size(), 2u);
+      EXPECT_NEAR((mesh.nodes[opening.nodes[1]].x - mesh.nodes[opening.nodes[0]].x).norm(), crack.lip_gap,
+                  1e-3 * crack.lip_gap);
+    }
   }
 }
 
