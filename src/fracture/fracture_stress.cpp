@@ -5,6 +5,7 @@
 
 #include "physics/face_element.hpp"
 #include "physics/membrane.hpp"
+#include "plasticity/bend_flow.hpp"
 #include "remesh/sizing.hpp"
 
 namespace arcsim {
@@ -41,7 +42,8 @@ bool is_breakable(const Face& face, const std::vector<Material>& materials) {
 
 bool needs_normals(const Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& faces) {
   for (int f : faces)
-    if (is_breakable(mesh.faces[f], materials) && materials[mesh.faces[f].material].fracture_bending_mult > 0)
+    if (is_breakable(mesh.faces[f], materials) && materials[mesh.faces[f].material].fracture_bending_mult > 0 &&
+        !has_bending_plasticity(materials[mesh.faces[f].material]))
       return true;
   return false;
 }
@@ -79,10 +81,41 @@ Mat2 rest_curvature(const Face& face, const std::vector<Vec3>& vert_normals) {
   return symmetric_part(face.rest_frame.transpose() * dn);
 }
 
+// Elastic hinge angle (rad) of each edge of face f: world dihedral minus rest angle (rest dihedral plus plastic
+// offset), what the bending elements' energy sees; 0 on a border edge (no hinge, no bending energy).
+Vec3 elastic_hinge_angles(const Mesh& mesh, int f) {
+  Vec3 angles;
+  for (int i = 0; i < 3; ++i) {
+    const int e = mesh.faces[f].e[i];
+    angles(i) = mesh.edges[e].is_boundary() ? 0.0 : std::remainder(mesh.world_dihedral(e) - mesh.edges[e].rest_theta,
+                                                                   2 * M_PI);
+  }
+  return angles;
+}
+
+// Face f's own hinge tensor in rest space (3x3, 1/m): R S R^T with R the face's rest frame.
+Mat3 face_hinge_curvature(const Mesh& mesh, int f) {
+  const Face& face = mesh.faces[f];
+  return face.rest_frame * face_bending_tensor(mesh, f, elastic_hinge_angles(mesh, f)) * face.rest_frame.transpose();
+}
+
+// The mean of the hinge tensors of vert v's live faces, weighted by their rest areas (rest space, 1/m).
+Mat3 vert_hinge_curvature(const Mesh& mesh, int v) {
+  Mat3 sum = Mat3::Zero();
+  double area = 0;
+  for (int f : mesh.verts[v].faces) {
+    if (mesh.faces[f].dead || !(mesh.faces[f].rest_area > 0)) continue;
+    sum += mesh.faces[f].rest_area * face_hinge_curvature(mesh, f);
+    area += mesh.faces[f].rest_area;
+  }
+  return area > 0 ? Mat3(sum / area) : Mat3::Zero();
+}
+
 // Eq. 8's factor (I + 1/2 alpha h II*) (dimensionless, material frame).
-Mat2 bending_stretch(const Mesh& mesh, int f, double alpha, const std::vector<Vec3>& node_normals,
-                     const std::vector<Vec3>& vert_normals) {
-  const Mat2 II = face_elastic_curvature(mesh, f, node_normals, vert_normals);
+Mat2 bending_stretch(const Mesh& mesh, const Material& material, int f, double alpha,
+                     const std::vector<Vec3>& node_normals, const std::vector<Vec3>& vert_normals) {
+  const Mat2 II = has_bending_plasticity(material) ? face_hinge_elastic_curvature(mesh, f)
+                                                   : face_elastic_curvature(mesh, f, node_normals, vert_normals);
   const Mat2 II_abs = map_symmetric_eigenvalues(II, [](double l) { return std::abs(l); });
   return Mat2::Identity() + 0.5 * alpha * mesh.faces[f].thickness * II_abs;
 }
@@ -93,6 +126,13 @@ Mat2 face_elastic_curvature(const Mesh& mesh, int f, const std::vector<Vec3>& no
                             const std::vector<Vec3>& vert_normals) {
   const Mat2 plastic = face_bending_tensor(mesh, f, plastic_angle_offsets(mesh, f));
   return world_curvature(mesh, f, node_normals) - rest_curvature(mesh.faces[f], vert_normals) - plastic;
+}
+
+Mat2 face_hinge_elastic_curvature(const Mesh& mesh, int f) {
+  const Face& face = mesh.faces[f];
+  Mat3 K = Mat3::Zero();
+  for (int i = 0; i < 3; ++i) K += vert_hinge_curvature(mesh, face.v[i]) / 3;
+  return face.rest_frame.transpose() * K * face.rest_frame;
 }
 
 FaceFractureStress face_fracture_stress(const Mesh& mesh, const std::vector<Material>& materials, int f,
@@ -106,7 +146,7 @@ FaceFractureStress face_fracture_stress(const Mesh& mesh, const std::vector<Mate
                                                    mesh.nodes[mesh.face_node(f, 1)].x,
                                                    mesh.nodes[mesh.face_node(f, 2)].x, face_elastic_dm_inv(face));
   const double alpha = material.fracture_bending_mult;
-  const Mat32 F_B = alpha > 0 ? Mat32(F_el * bending_stretch(mesh, f, alpha, node_normals, vert_normals)) : F_el;
+  const Mat32 F_B = alpha > 0 ? Mat32(F_el * bending_stretch(mesh, material, f, alpha, node_normals, vert_normals)) : F_el;
   const Mat2 G = 0.5 * (F_B.transpose() * F_B - Mat2::Identity());
   const Mat2 sigma = membrane_stress(G, face_membrane_stiffness(face, material));
   out.sigma = map_symmetric_eigenvalues(sigma, [](double l) { return std::max(l, 0.0); });

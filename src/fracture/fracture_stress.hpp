@@ -16,6 +16,16 @@
 // glass sphere at rest does not crack) and the plastic curvature (the bending tensor of the edges' plastic
 // angle offsets, rest_theta - rest dihedral, remesh/sizing.hpp's face_bending_tensor). With alpha = 0 the
 // bending term is skipped entirely (F_B = F_el).
+// A material with bending plasticity (finite yield_curv) measures II on the hinges instead: each face's bending
+// tensor (face_bending_tensor) of its edges' elastic angles, world dihedral minus rest_theta (rest dihedral plus
+// plastic offset), 0 on a border edge; averaged at each vert over its faces by rest area, and a face's II is the
+// mean of its three corner verts' (rest space); ARCSim filters its bending-fracture curvature the same way. WHY:
+// the plastic state lives on the hinges, so the elastic part must be measured with the same operator. The normal
+// derivative minus the plastic hinges' tensor disagreed on a crack's lips (a border node's normal averages one
+// side only, a border edge has no plastic hinge): the plastically folded tube of paper Fig. 9 read elastic
+// curvatures of 1e3 1/m on its new lip faces and cracked on in parallel slivers (docs/stability.md, 2026-12-05
+// evening). Elastic materials keep the normal derivative: with the hinge measure conf/paper-dome.json (acrylic)
+// cracked differently and left 2 intersecting triangle pairs in 11 of its 13 frames.
 // Sign: II > 0 along a direction in which the sheet bends away from its normal side (the normals spread, as on
 // a sphere with outward normals); dihedral angles (mesh.hpp) are negative where it bends towards it, and the
 // bending tensor of the angles has their sign, so the plastic part cancels the world part of a sheet resting in
@@ -37,6 +47,10 @@ namespace arcsim {
 Mat2 face_elastic_curvature(const Mesh& mesh, int f, const std::vector<Vec3>& node_normals,
                             const std::vector<Vec3>& vert_normals);
 
+// The same for a material with bending plasticity: its corner verts' mean of the hinges' elastic bending tensors
+// (see above). Unlike face_elastic_curvature, a sheet resting in its plastic shape reads zero on border faces too.
+Mat2 face_hinge_elastic_curvature(const Mesh& mesh, int f);
+
 // The tensile fracture stress of one face.
 struct FaceFractureStress {
   Mat2 sigma = Mat2::Zero();   // sigma+ (N/m), face material frame (Face::rest_frame columns t1, t2)
@@ -44,7 +58,7 @@ struct FaceFractureStress {
 };
 
 // sigma+ of face f. `node_normals` / `vert_normals` are only read when the face's material has
-// fracture_bending_mult > 0 (they may be empty otherwise).
+// fracture_bending_mult > 0 and no bending plasticity (they may be empty otherwise).
 FaceFractureStress face_fracture_stress(const Mesh& mesh, const std::vector<Material>& materials, int f,
                                         const std::vector<Vec3>& node_normals,
                                         const std::vector<Vec3>& vert_normals);
