@@ -83,13 +83,33 @@ int total_cracks(const std::string& log) {
 // The lowest z of a saved frame's cloth OBJ (m).
 double lowest_z(const std::string& obj) {
   double lowest = std::numeric_limits<double>::infinity();
-  for (const std::string& line : lines_of(read_text(obj))) {
-    if (line.rfind("v ", 0) != 0) continue;
-    std::istringstream in(line.substr(2));
-    double x, y, z;
-    if (in >> x >> y >> z) lowest = std::min(lowest, z);
-  }
+  for (const auto& v : obj_vertices(obj)) lowest = std::min(lowest, v[2]);
   return lowest;
+}
+
+// A shipped scene run to its end with one thread (exit 0 asserted by the caller through `ok`), its frames
+// inspected every `every` (exit 0 expected) and its last frame inspected: the inspection's JSON lines in `last`.
+struct SceneRun {
+  std::string dir;
+  RunResult last;
+  bool ok = false;
+};
+
+SceneRun run_and_inspect(const std::string& conf, const TempFolder& out, const std::string& every) {
+  SceneRun result;
+  const std::string scene = repo_file(conf);
+  EXPECT_FALSE(scene.empty()) << conf << " not found";
+  if (scene.empty()) return result;
+  result.dir = (out.path() / "run").string();
+  const RunResult run = run_arcsim({"simulate", scene, result.dir, "--quiet", "--threads", "1"});
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  if (run.exit_code != 0) return result;
+  const RunResult sampled = run_arcsim({"inspect", result.dir, "--every", every, "--quiet"});
+  EXPECT_EQ(sampled.exit_code, 0) << sampled.out << sampled.err;
+  result.last = run_arcsim({"inspect", result.dir, "--last", "--quiet"});
+  EXPECT_EQ(result.last.exit_code, 0) << result.last.err;
+  result.ok = result.last.exit_code == 0;
+  return result;
 }
 
 // Fig. 1: one press of a ball 1 cm into five clamped sheets. With the default contact settings (1e9 N/m^3, 1 mm)
@@ -98,16 +118,11 @@ double lowest_z(const std::string& obj) {
 // and steel keep a plastic dent, the elastic cork and vinyl spring back flat. About 20 s.
 TEST(ConfScenes, SlowCheckPaperVarietySheetsRespondEachAsTheirMaterial) {
   ARCSIM_REQUIRE_BINARY();
-  const std::string scene = repo_file("conf/paper-variety.json");
-  ASSERT_FALSE(scene.empty()) << "conf/paper-variety.json not found";
   TempFolder out;
-  const std::string run_dir = (out.path() / "run").string();
-  const RunResult run = run_arcsim({"simulate", scene, run_dir, "--quiet", "--threads", "1"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const RunResult sampled = run_arcsim({"inspect", run_dir, "--every", "5", "--quiet"});
-  EXPECT_EQ(sampled.exit_code, 0) << sampled.out << sampled.err;
-  const RunResult last = run_arcsim({"inspect", run_dir, "--last", "--quiet"});
-  ASSERT_EQ(last.exit_code, 0) << last.err;
+  const SceneRun run = run_and_inspect("conf/paper-variety.json", out, "5");
+  ASSERT_TRUE(run.ok);
+  const std::string& run_dir = run.dir;
+  const RunResult& last = run.last;
   const std::vector<int> pieces = pieces_per_sheet(last.out);  // cork, foil, acrylic, steel, vinyl
   ASSERT_EQ(pieces.size(), 5u) << last.out;
   EXPECT_GE(pieces[2], 2) << "acrylic should break";
@@ -127,16 +142,10 @@ TEST(ConfScenes, SlowCheckPaperVarietySheetsRespondEachAsTheirMaterial) {
 // of the top while the dome stands. About 40 s.
 TEST(ConfScenes, SlowCheckPaperDomeBreaksAHoleOfShardsAndStands) {
   ARCSIM_REQUIRE_BINARY();
-  const std::string scene = repo_file("conf/paper-dome.json");
-  ASSERT_FALSE(scene.empty()) << "conf/paper-dome.json not found";
   TempFolder out;
-  const std::string run_dir = (out.path() / "run").string();
-  const RunResult run = run_arcsim({"simulate", scene, run_dir, "--quiet", "--threads", "1"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const RunResult every = run_arcsim({"inspect", run_dir, "--every", "1", "--quiet"});
-  EXPECT_EQ(every.exit_code, 0) << every.out << every.err;
-  const RunResult last = run_arcsim({"inspect", run_dir, "--last", "--quiet"});
-  ASSERT_EQ(last.exit_code, 0) << last.err;
+  const SceneRun run = run_and_inspect("conf/paper-dome.json", out, "1");
+  ASSERT_TRUE(run.ok);
+  const RunResult& last = run.last;
   const std::vector<int> pieces = pieces_per_sheet(last.out);
   ASSERT_EQ(pieces.size(), 1u) << last.out;
   EXPECT_GE(pieces[0], 50) << "shards";
@@ -150,16 +159,11 @@ TEST(ConfScenes, SlowCheckPaperDomeBreaksAHoleOfShardsAndStands) {
 // (docs/stability.md, 2026-12-05 evening). About 3 min.
 TEST(ConfScenes, SlowCheckPaperCylinderBucklesAndCracksAlongItsFolds) {
   ARCSIM_REQUIRE_BINARY();
-  const std::string scene = repo_file("conf/paper-cylinder.json");
-  ASSERT_FALSE(scene.empty()) << "conf/paper-cylinder.json not found";
   TempFolder out;
-  const std::string run_dir = (out.path() / "run").string();
-  const RunResult run = run_arcsim({"simulate", scene, run_dir, "--quiet", "--threads", "1"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const RunResult sampled = run_arcsim({"inspect", run_dir, "--every", "5", "--quiet"});
-  EXPECT_EQ(sampled.exit_code, 0) << sampled.out << sampled.err;
-  const RunResult last = run_arcsim({"inspect", run_dir, "--last", "--quiet"});
-  ASSERT_EQ(last.exit_code, 0) << last.err;
+  const SceneRun run = run_and_inspect("conf/paper-cylinder.json", out, "5");
+  ASSERT_TRUE(run.ok);
+  const std::string& run_dir = run.dir;
+  const RunResult& last = run.last;
   // The top rim went down 2 cm: the tube is 10 cm tall at the end (12 cm at rest).
   const std::vector<std::array<double, 3>> end = obj_vertices(run_dir + "/00030_00.obj");
   ASSERT_FALSE(end.empty());
