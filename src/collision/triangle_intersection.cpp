@@ -167,4 +167,12 @@ bool triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>
   return false;
 }
 
+// Two closed triangles sharing a corner p meet in a convex set holding p. If it holds a second point q, the
+// segment pq leaves through the edge opposite p of one of them (up to collinear edges), and that edge crosses
+// the other triangle.
+bool triangles_meet_beyond_corner(const std::array<Vec3, 3>& s, int i, const std::array<Vec3, 3>& t, int j) {
+  return segment_meets_triangle(s[(i + 1) % 3], s[(i + 2) % 3], t) ||
+         segment_meets_triangle(t[(j + 1) % 3], t[(j + 2) % 3], s);
+}
+
 }  // namespace arcsim

@@ -19,4 +19,8 @@ int orient2d(const Vec3& a, const Vec3& b, const Vec3& c, int drop);
 // Closed triangles s and t share at least one point.
 bool triangles_intersect(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t);
 
+// Triangles s and t that share the corner s[i] == t[j] (the same point) meet somewhere else too: the surface
+// folds through itself there (an edge of one crosses the other). Coplanar triangles count as not meeting.
+bool triangles_meet_beyond_corner(const std::array<Vec3, 3>& s, int i, const std::array<Vec3, 3>& t, int j);
+
 }  // namespace arcsim

@@ -55,6 +55,16 @@ Vec3 rest_move_of(const Mesh& m, int f, const Vec3& displacement) {
   return move.allFinite() ? move : Vec3::Zero();
 }
 
+// The faces of `a` and `b`, sorted, each once (what the guard's fold test skips: the exempt faces and the moving
+// node's own fan, which it checks as triangles).
+std::vector<int> fan_and(const std::vector<int>& a, const std::vector<int>& b) {
+  std::vector<int> out = a;
+  out.insert(out.end(), b.begin(), b.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 void shift_node(Node& node, const Vec3& shift) {
   if (!shift.allFinite()) return;
   node.x += shift;
@@ -506,6 +516,7 @@ bool EditSession::move_allowed(int node, const std::vector<int>& faces, const Ve
   }
   std::vector<int> exempt = options.exempt_faces;
   std::sort(exempt.begin(), exempt.end());
+  if (guard_->folds_through_neighbours(after, fan_and(exempt, m_.node_faces(node)))) return false;
   if (!options.require_clearance) return guard_->sweep_is_clear(sweeps, exempt);
   return guard_->allows(before, after, sweeps, exempt);
 }
@@ -544,12 +555,15 @@ bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, 
                             const NodeMoveOptions& options) {
   if (!guard_) return true;
   auto allowed = [&] {
+    // The fan is checked against itself and the faces it touches (the guard's other tests skip those).
+    const std::vector<GuardTriangle> moved = guard_->fan(node);
+    if (guard_->folds_through_neighbours(moved, fan_and(options.exempt_faces, m_.node_faces(node)))) return false;
     if (!options.require_clearance) {
       std::vector<int> sorted = options.exempt_faces;
       std::sort(sorted.begin(), sorted.end());
       return guard_->sweep_is_clear(guard_->fan_sweep(node, x), sorted);
     }
-    return guard_->allows(before, guard_->fan(node), guard_->fan_sweep(node, x), options.exempt_faces);
+    return guard_->allows(before, moved, guard_->fan_sweep(node, x), options.exempt_faces);
   };
   if (m_.nodes[node].x != x && !allowed()) {
     m_.nodes[node].x = x;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "collision/distance.hpp"
+#include "collision/triangle_intersection.hpp"
 
 namespace arcsim {
 
@@ -253,6 +254,43 @@ bool WorldGuard::sweep_is_clear(const std::vector<GuardSweep>& sweeps, const std
     }
   }
   return true;
+}
+
+namespace {
+
+// The corners of a and b at their one shared node, or {-1, -1} unless they share exactly one (kNone never
+// counts).
+std::array<int, 2> single_shared_corner(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  std::array<int, 2> found{-1, -1};
+  int shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (a[i] != kNone && a[i] == b[j]) found = {i, j}, ++shared;
+  return shared == 1 ? found : std::array<int, 2>{-1, -1};
+}
+
+}  // namespace
+
+bool WorldGuard::folds_through_neighbours(const std::vector<GuardTriangle>& triangles,
+                                          const std::vector<int>& replaced) const {
+  auto folds = [](const GuardTriangle& a, const GuardTriangle& b) {
+    const std::array<int, 2> c = single_shared_corner(a.nodes, b.nodes);
+    return c[0] >= 0 && triangles_meet_beyond_corner(a.x, c[0], b.x, c[1]);
+  };
+  Eigen::AlignedBox3d all;
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    all.extend(box_of(triangles[i].x, 0));
+    for (size_t k = i + 1; k < triangles.size(); ++k)
+      if (folds(triangles[i], triangles[k])) return true;
+  }
+  if (triangles.empty() || !all.min().allFinite() || !all.max().allFinite()) return false;
+  for (const std::int64_t entry : candidates(all)) {
+    if (entry >> 32 != 0 || !counts(entry, replaced)) continue;
+    const GuardTriangle other = triangle(0, static_cast<int>(entry & 0xffffffff));
+    for (const GuardTriangle& t : triangles)
+      if (folds(t, other)) return true;
+  }
+  return false;
 }
 
 bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,

@@ -52,6 +52,15 @@ class WorldGuard {
   // True if no face the triangles may not approach (as for separation) meets one of the tetrahedra.
   bool sweep_is_clear(const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const;
 
+  // True if one of the triangles folds through a face it touches at a single node: a face of the edited mesh
+  // (not in `replaced`, sorted) or another of the triangles, sharing exactly one corner node with it, that it
+  // meets anywhere else. WHY: separation and sweep_is_clear skip the faces a triangle touches, and a node
+  // moved across its own fan (the reprojection after an edge split next to a crack tip, 2 mm through a 3 mm
+  // fan) leaves two faces crossing that count as adjacent; the next edit that splits one of them makes the
+  // crossing visible to collision handling, which cannot undo it (docs/repro/glass-plate-shards-coincident-lips.json:
+  // one such move, 146 crossing pairs after the local remesh refined around it).
+  bool folds_through_neighbours(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced) const;
+
   // True if an edit replacing the triangles `before` by `after` through `sweeps` keeps the surface clear: it
   // sweeps through nothing, and `after` keeps the clearance or comes no closer to anything than `before` was.
   bool allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,

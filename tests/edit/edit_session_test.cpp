@@ -3,16 +3,19 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "collision/triangle_intersection.hpp"
 #include "physics/plate_bending.hpp"
 #include "physics/cloth_physics.hpp"
 #include "edit/edit_fixtures.hpp"
 #include "edit/edit_session.hpp"
 #include "mesh/validate.hpp"
 #include "physics/cloth_physics.hpp"
+#include "remesh/remesh_fixtures.hpp"
 #include "remesh/reprojection.hpp"
 #include "restshape/reference_surface.hpp"
 
@@ -328,9 +331,6 @@ TEST(EditSessionHooks, StagesSeeTheMeshInTheDocumentedState) {
   EXPECT_LT(probe.world_off[EditStage::kRestPositions], 0.5 * probe.world_off[EditStage::kTrack]);
 }
 
-}  // namespace
-}  // namespace arcsim
-
 namespace arcsim {
 namespace {
 
@@ -366,6 +366,76 @@ TEST(EditSessionStressFreeMove, KeepsTheBendingEnergyOfABentSheet) {
   ASSERT_TRUE(session.move_node(node, Vec3(0.3, 0.3, 0.3).normalized() * 2e-3, move));
   const double after = bending_energy_of(m, s.materials);
   EXPECT_NEAR(after, before, 1e-9 + 1e-6 * before) << "bending energy before " << before << " J";
+}
+
+}  // namespace
+}  // namespace arcsim
+
+namespace fold_test {
+
+// Pairs of faces sharing exactly one node that meet elsewhere too (each shrunk by 1e-6 towards its centroid, so
+// that the shared node itself no longer counts): a fold of the surface through itself, which `arcsim inspect`
+// does not see while the two faces share the node, and sees once an edit splits one of them.
+int folded_pairs(const Mesh& m) {
+  auto shrunk = [&](int f) {
+    std::array<Vec3, 3> t;
+    Vec3 c = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) c += m.nodes[m.face_node(f, i)].x / 3;
+    for (int i = 0; i < 3; ++i) t[i] = c + (1 - 1e-6) * (m.nodes[m.face_node(f, i)].x - c);
+    return t;
+  };
+  int count = 0;
+  for (size_t f = 0; f < m.faces.size(); ++f)
+    for (size_t g = f + 1; g < m.faces.size(); ++g) {
+      if (m.faces[f].dead || m.faces[g].dead) continue;
+      int shared = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) shared += m.face_node(int(f), i) == m.face_node(int(g), j);
+      if (shared == 1 && triangles_intersect(shrunk(int(f)), shrunk(int(g)))) ++count;
+    }
+  return count;
+}
+
+// A crumpled hexagonal fan: centre node 0, ring nodes 1-6 (unit radius) alternately 0.3 up and down.
+Mesh crumpled_fan() {
+  std::vector<Vec3> p{Vec3::Zero()};
+  for (int k = 0; k < 6; ++k)
+    p.emplace_back(std::cos(k * M_PI / 3), std::sin(k * M_PI / 3), k % 2 ? 0.3 : -0.3);
+  std::vector<std::array<int, 3>> tris;
+  for (int k = 0; k < 6; ++k) tris.push_back({0, 1 + k, 1 + (k + 1) % 6});
+  return remesh_test::mesh_from(p, tris);
+}
+
+}  // namespace fold_test
+
+// A node moved across its own fan (here past the ring node it heads for) folds faces of the fan through each
+// other. The world guard skipped every face the moving faces touch, so it kept such moves: an edge split's
+// reprojection next to a crack tip moved its node 2 mm through a 3 mm fan, and the local remesh that refined the
+// two faces afterwards left 146 crossing pairs (docs/repro/glass-plate-shards-coincident-lips.json, step 21).
+TEST(EditSessionGuard, RefusesANodeMoveThatFoldsItsFanThroughItself) {
+  const std::vector<Material> materials{remesh_test::glass()};
+  const Vec3 across(1.6, 0.05, 0.0);  // m: the centre to beyond ring node 1 at (1, 0, -0.3)
+  {
+    // The premise: unguarded, the move is kept and folds the fan.
+    Mesh m = fold_test::crumpled_fan();
+    ASSERT_EQ(fold_test::folded_pairs(m), 0);
+    EditSession session(m, materials, EditSessionOptions{});
+    ASSERT_TRUE(session.move_node(0, across));
+    ASSERT_GT(fold_test::folded_pairs(m), 0);
+  }
+  Mesh m = fold_test::crumpled_fan();
+  EditSessionOptions options;
+  options.world_clearance = 1e-4;
+  EditSession session(m, materials, options);
+  const std::vector<int> fan = m.node_faces(0);
+  EXPECT_FALSE(session.move_allowed(0, fan, across));
+  EXPECT_FALSE(session.move_node(0, across));
+  EXPECT_EQ(m.nodes[0].x, Vec3::Zero());
+  EXPECT_EQ(fold_test::folded_pairs(m), 0);
+  // A short move within the fan stays allowed.
+  EXPECT_TRUE(session.move_allowed(0, fan, Vec3(0.2, 0.05, 0)));
+  EXPECT_TRUE(session.move_node(0, Vec3(0.2, 0.05, 0)));
+  EXPECT_EQ(fold_test::folded_pairs(m), 0);
 }
 
 }  // namespace
