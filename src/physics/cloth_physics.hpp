@@ -146,7 +146,9 @@ VecX factor_and_solve(CholeskySolver& solver, const BlockSystem& system, const s
                       StepTiming& timing, const std::function<std::string()>& explain = {});
 
 // One implicit Euler step of size dt (s): solves for the velocity change, then v += dv, a = dv/dt, x0 = x,
-// x += v dt. Throws NumericalError if the system cannot be factorised or the result is not finite.
+// x += v dt. If the whole dv raises the step's incremental potential (the linearisation failed: see
+// step_fraction in cloth_physics.cpp), it takes the first of dv/2, dv/4, ... that does not.
+// Throws NumericalError if the system cannot be factorised or the result is not finite.
 void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver, const ExternalLoads& loads,
                          double dt, StepTiming* timing = nullptr);
 
