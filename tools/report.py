@@ -205,6 +205,31 @@ def fmt(x, spec):
     return "-" if x is None or x != x else format(x, spec)
 
 
+def shard_comparison(results, args):
+    """Fig. 10's claim measured: the pieces of the adaptive and the static ornament's last frames (tools/pieces.py:
+    count, shards of >= 3 faces, size spread, histogram of area fractions), when both ran."""
+    runs = {r["name"]: r for r in results if "total" in r}
+    pair = ("paper-ornament", "paper-ornament-static")
+    if not all(name in runs for name in pair):
+        return []
+    sys.path.insert(0, HERE)
+    import pieces
+    summaries = [pieces.summarise(pieces.newest_frame(os.path.join(args.out, name))) for name in pair]
+    lines = ["", "Fig. 10, adaptive against static (last frame of each, `tools/pieces.py`; the paper: the static "
+             "mesh gives fewer, bigger and more uniform shards):", "",
+             "| run | faces mean | pieces | shards (>= 3 faces) | largest piece | shard area CV | shard area Gini |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name, s in zip(pair, summaries):
+        lines.append("| `%s` | %.0f | %d | %d | %.1f%% | %.2f | %.2f |" % (
+            name, runs[name]["faces_mean"], s["pieces"], s["shards"], 100 * s["largest_fraction"],
+            s["shard_area_cv"], s["shard_area_gini"]))
+    lines += ["", "Pieces per bin of area fraction of the whole ball:", "",
+              "| bin | " + " | ".join("`%s`" % name for name in pair) + " |", "|---|---:|---:|"]
+    for k, label in enumerate(summaries[0]["histogram_bins"]):
+        lines.append("| %s | %d | %d |" % (label, summaries[0]["histogram"][k], summaries[1]["histogram"][k]))
+    return lines
+
+
 def markdown(results, arcsim_rows, args):
     today = datetime.date.today().isoformat()
     lines = [
@@ -246,6 +271,7 @@ def markdown(results, arcsim_rows, args):
             rel = os.path.relpath(os.path.join(args.img, r["name"] + ".png"), os.path.join(ROOT, "docs"))
             lines.append("- `%s` (frames %s): ![%s](%s)" % (r["name"], ", ".join(map(str, r["sheet_frames"])),
                                                            r["name"], rel))
+    lines += shard_comparison(results, args)
     if arcsim_rows:
         lines += ["", "ARCSim 0.3.1's fracture scenes, both engines in this run (wall s per simulated s):", "",
                   "| scene | to (s) | ours | ARCSim | ratio |", "|---|---:|---:|---:|---:|"]
