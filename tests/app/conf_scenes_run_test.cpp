@@ -121,20 +121,18 @@ TEST(ConfScenes, SlowCheckPaperVarietySheetsRespondEachAsTheirMaterial) {
   TempFolder out;
   const SceneRun run = run_and_inspect("conf/paper-variety.json", out, "5");
   ASSERT_TRUE(run.ok);
-  const std::string& run_dir = run.dir;
-  const RunResult& last = run.last;
-  const std::vector<int> pieces = pieces_per_sheet(last.out);  // cork, foil, acrylic, steel, vinyl
-  ASSERT_EQ(pieces.size(), 5u) << last.out;
+  const std::vector<int> pieces = pieces_per_sheet(run.last.out);  // cork, foil, acrylic, steel, vinyl
+  ASSERT_EQ(pieces.size(), 5u) << run.last.out;
   EXPECT_GE(pieces[2], 2) << "acrylic should break";
   EXPECT_EQ(pieces[3], 1) << "steel should dent, not break";
   EXPECT_EQ(pieces[4], 1) << "vinyl should not break";
   // The sheets lie at z = 0 and are pressed 1 cm; the last frame (80 ms) is long after the ball has left.
-  const auto last_z = [&](int sheet) { return lowest_z(run_dir + "/00040_0" + std::to_string(sheet) + ".obj"); };
+  const auto last_z = [&](int sheet) { return lowest_z(run.dir + "/00040_0" + std::to_string(sheet) + ".obj"); };
   EXPECT_LT(last_z(1), -3e-3) << "foil keeps a plastic dent";
   EXPECT_LT(last_z(3), -3e-3) << "steel keeps a plastic dent";
   EXPECT_GT(last_z(0), -1e-3) << "cork springs back";
   EXPECT_GT(last_z(4), -1e-3) << "vinyl springs back";
-  EXPECT_LT(lowest_z(run_dir + "/00010_04.obj"), -5e-3) << "the ball pressed the vinyl";
+  EXPECT_LT(lowest_z(run.dir + "/00010_04.obj"), -5e-3) << "the ball pressed the vinyl";
 }
 
 // Fig. 11 left: a 20 m/s ball through an acrylic dome. With the draft's soft contact (1e11 N/m^3, 0.5 mm) pieces
@@ -145,11 +143,10 @@ TEST(ConfScenes, SlowCheckPaperDomeBreaksAHoleOfShardsAndStands) {
   TempFolder out;
   const SceneRun run = run_and_inspect("conf/paper-dome.json", out, "1");
   ASSERT_TRUE(run.ok);
-  const RunResult& last = run.last;
-  const std::vector<int> pieces = pieces_per_sheet(last.out);
-  ASSERT_EQ(pieces.size(), 1u) << last.out;
+  const std::vector<int> pieces = pieces_per_sheet(run.last.out);
+  ASSERT_EQ(pieces.size(), 1u) << run.last.out;
   EXPECT_GE(pieces[0], 50) << "shards";
-  const auto [largest, faces] = largest_piece_and_faces(last.out);
+  const auto [largest, faces] = largest_piece_and_faces(run.last.out);
   EXPECT_GE(largest, faces / 5) << "the dome itself stays one piece";
 }
 
@@ -162,10 +159,8 @@ TEST(ConfScenes, SlowCheckPaperCylinderBucklesAndCracksAlongItsFolds) {
   TempFolder out;
   const SceneRun run = run_and_inspect("conf/paper-cylinder.json", out, "5");
   ASSERT_TRUE(run.ok);
-  const std::string& run_dir = run.dir;
-  const RunResult& last = run.last;
   // The top rim went down 2 cm: the tube is 10 cm tall at the end (12 cm at rest).
-  const std::vector<std::array<double, 3>> end = obj_vertices(run_dir + "/00030_00.obj");
+  const std::vector<std::array<double, 3>> end = obj_vertices(run.dir + "/00030_00.obj");
   ASSERT_FALSE(end.empty());
   double top = -1, radial = 0;
   for (const auto& [x, y, z] : end) {
@@ -175,8 +170,8 @@ TEST(ConfScenes, SlowCheckPaperCylinderBucklesAndCracksAlongItsFolds) {
   }
   EXPECT_NEAR(top, 0.10, 1e-3) << "the clamp pushed the top rim 2 cm down";
   EXPECT_GT(radial, 3e-3) << "the tube buckles into lobes";
-  EXPECT_GE(total_cracks(run_dir + "/log.jsonl"), 20) << "the folds crack";
-  const auto [largest, faces] = largest_piece_and_faces(last.out);
+  EXPECT_GE(total_cracks(run.dir + "/log.jsonl"), 20) << "the folds crack";
+  const auto [largest, faces] = largest_piece_and_faces(run.last.out);
   EXPECT_GE(largest, 9 * faces / 10) << "the tube cracks, it does not shatter";
 }
 
