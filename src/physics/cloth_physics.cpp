@@ -154,7 +154,7 @@ double internal_energy_at(const std::vector<Vec3>& x, const ElementCache& cache)
       const BendingElement& b = cache.bending[k - faces];
       std::array<Vec3, 6> corners;
       for (int i = 0; i < 6; ++i) corners[i] = x[b.nodes[i]];
-      energy[k] = plate_bending_terms(corners, b.has_wing, b.rest_theta, b.Q, HessianKind::kNone).energy;
+      energy[k] = plate_bending_energy(corners, b.has_wing, b.rest_theta, b.Q);
     }
   }
   double sum = 0;

@@ -29,6 +29,17 @@ std::array<int, 4> hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 +
 
 }  // namespace
 
+double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
+                            const Vec3& rest_theta, const Mat3& Q) {
+  Vec3 delta = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (!has_wing[i]) continue;
+    const auto s = hinge_slots(i);
+    delta[i] = wrap_angle(dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]) - rest_theta[i]);
+  }
+  return delta.dot(Q * delta);
+}
+
 PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                                       const Vec3& rest_theta, const Mat3& Q, HessianKind hessian) {
   PlateBendingTerms out;

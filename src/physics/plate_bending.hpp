@@ -47,4 +47,9 @@ struct PlateBendingTerms {
 PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                                       const Vec3& rest_theta, const Mat3& Q, HessianKind hessian);
 
+// The energy alone (J), equal to plate_bending_terms(...).energy, without the angles' gradients (for energy
+// checks that evaluate every element several times per step).
+double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
+                            const Vec3& rest_theta, const Mat3& Q);
+
 }  // namespace arcsim

@@ -40,8 +40,17 @@ Element random_element(std::mt19937& rng, bool boundary_edge) {
   return e;
 }
 
-double energy(const Element& e) {
-  return plate_bending_terms(e.x, e.has_wing, e.rest_theta, e.Q, HessianKind::kNone).energy;
+// The energy-only evaluation: the finite differences below check plate_bending_terms' gradient against it.
+double energy(const Element& e) { return plate_bending_energy(e.x, e.has_wing, e.rest_theta, e.Q); }
+
+TEST(PlateBending, EnergyAloneEqualsTheTermsEnergyBitForBit) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 40; ++trial) {
+    const Element e = random_element(rng, trial % 4 == 3);
+    const double terms = plate_bending_terms(e.x, e.has_wing, e.rest_theta, e.Q, HessianKind::kNone).energy;
+    EXPECT_GT(terms, 0) << "trial " << trial;
+    EXPECT_EQ(energy(e), terms) << "trial " << trial;  // the step's energy check must see the same numbers
+  }
 }
 
 TEST(PlateBending, GradientAndHessianMatchFiniteDifferences) {
