@@ -66,6 +66,7 @@ ImpactZoneStats CollisionHandler::resolve_collisions(const std::vector<Mesh*>& c
   params.floor = settings.floor;
   params.floor_height = settings.floor_height;
   params.step = settings.step;
+  params.stacked_lips_keep_start_side = settings.stacked_lips_keep_start_side;
   params.work_budget = settings.work_budget;
   const ImpactZoneStats stats = resolve_impacts(geometry_, cache_, params);
   totals_.add(stats);

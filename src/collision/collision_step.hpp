@@ -26,6 +26,7 @@ struct CollisionSettings {
   // gap new cracks open with.
   double neighbour_thickness = 0;
   int step = 0;                        // for messages
+  bool stacked_lips_keep_start_side = false;  // ImpactZoneParams::stacked_lips_keep_start_side
   // Work units (collision/impact_zones.hpp) the impact-zone response of one step may spend.
   double work_budget = kInfinity;
 };

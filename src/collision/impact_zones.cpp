@@ -54,7 +54,8 @@ Vec3 facing_borders_normal(const ContactGeometry& g, const PrimitivePair& p, con
 // the glass to 1e3-1e8 times its toughness (conf/paper-metal-glass.json on an AMD EPYC guest). Facing lips
 // are apart across their edges, within the sheet, whichever way they twist.
 Vec3 near_parallel_edge_normal(const ContactGeometry& g, const PrimitivePair& p, const std::array<int, 4>& nodes,
-                               const std::array<double, 4>& weights, double t, double reach, const Vec3& normal) {
+                               const std::array<double, 4>& weights, double t, double reach, bool keep_stacked,
+                               const Vec3& normal) {
   auto at = [&](int n) { return Vec3(g.x0[n] + t * (g.x1[n] - g.x0[n])); };
   const Vec3 a = at(nodes[1]) - at(nodes[0]), b = at(nodes[3]) - at(nodes[2]);
   const double lengths = a.norm() * b.norm();
@@ -71,9 +72,16 @@ Vec3 near_parallel_edge_normal(const ContactGeometry& g, const PrimitivePair& p,
   Vec3 start_gap = Vec3::Zero();
   for (int i = 0; i < 4; ++i) start_gap += weights[i] * g.x0[nodes[i]];
   const Vec3 facing = facing_borders_normal(g, p, nodes, t, start_gap, reach);
-  if (facing.norm() > 0) return facing;
   const double start_side = surface.dot(start_gap), contact_side = surface.dot(normal);
-  if (std::abs(start_side) > 0.1 * start_gap.norm() && start_side != 0) return start_side > 0 ? surface : -surface;
+  const bool side_clear = std::abs(start_side) > 0.1 * start_gap.norm() && start_side != 0;
+  // Stacked lips (ImpactZoneParams::stacked_lips_keep_start_side): they start overlapped across their edges (one
+  // lip's edge over the other's face) and apart out of the surface, so they stay on the side they start on. WHY:
+  // across the edges, the facing normal is reached from such a start only by the edges passing each other; the
+  // motion may already meet it at its end, so every detection round found the same crossing again and the zone
+  // fell back at every substep (docs/repro/glass-plate-stacked-lips.json).
+  const bool stacked = keep_stacked && facing.dot(start_gap) < 0 && side_clear;
+  if (facing.norm() > 0 && !stacked) return facing;
+  if (side_clear) return start_side > 0 ? surface : -surface;
   if (std::abs(contact_side) > 0.1) return contact_side > 0 ? surface : -surface;
   return normal;
 }
@@ -136,7 +144,8 @@ std::vector<ImpactRecord> detect_impacts(const ContactGeometry& g, BvhCache& cac
     r.normal = hit->contact.normal;
     r.time = hit->time;
     if (p.kind == PairKind::kEdgeEdge) {
-      r.normal = near_parallel_edge_normal(g, p, nodes, r.weights, r.time, params.thickness, r.normal);
+      r.normal = near_parallel_edge_normal(g, p, nodes, r.weights, r.time, params.thickness,
+                                            params.stacked_lips_keep_start_side, r.normal);
       r.normal = end_to_end_normal(g, nodes, r.weights, r.time, params.thickness, r.normal);
     }
     found[k] = r;

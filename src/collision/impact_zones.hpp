@@ -27,6 +27,10 @@ struct ImpactZoneParams {
   double floor_height = 0;         // m
   ZoneMethod method = ZoneMethod::kAutomatic;
   int step = 0;                    // for messages
+  // Crack lips that start stacked (overlapped across their edges, apart out of the surface) keep the side they
+  // start on, instead of the facing lips' normal across their edges (impact_zones.cpp, near_parallel_edge_normal).
+  // The simulation sets it at the adaptive step's finest substep only (docs/stability.md, 2026-12-06 (h2)).
+  bool stacked_lips_keep_start_side = false;
   // Work budget of one resolve_impacts, in work units (zone_evaluation_work per evaluation of a zone's
   // projection, kCcdPairWork per candidate pair tested): once spent, the response stops unresolved with
   // ImpactZoneStats::out_of_budget. Counted, not timed, so that where it stops is the same on every machine and

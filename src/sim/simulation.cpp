@@ -249,6 +249,10 @@ CollisionSettings Simulation::collision_settings() const {
   // keeps the full thickness between all parts of a sheet, as ARCSim has it (its frames stay as they were).
   s.neighbour_thickness = scene_.enabled("fracture") ? fracture.opening.lip_gap : s.repulsion_thickness;
   s.step = step_;
+  // At the finest substep a fallback can no longer be substepped away, and stacked crack lips keep the side
+  // they start on (at coarser levels their fallback made the step substep, which bounds the collision
+  // correction: docs/stability.md, 2026-12-06 (h2)).
+  s.stacked_lips_keep_start_side = finest_substep_;
   s.work_budget = scene_.collision_budget * static_cast<double>(cloth_node_count(cloths));
   // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
   for (const Obstacle& o : obstacles) {
@@ -487,6 +491,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
   for (;;) {
     const int substeps = 1 << substep_level_;
     const double h = dt / substeps;
+    finest_substep_ = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
     std::string problem;
     std::vector<std::vector<int>> fallback_nodes(cloths.size());
     try {
@@ -515,6 +520,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
         --substep_level_;
         steps_at_level_ = 0;
       }
+      finest_substep_ = false;
       return h;
     }
     restore_snapshot(snapshot, cloths);
@@ -526,6 +532,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
       what << "step " << step_ << " (t = " << start << " to " << start + dt << " s) failed at the smallest substep "
            << h << " s (adaptive_time_step.min_step " << a.min_step << " s): " << problem
            << "; try a smaller min_step or time step";
+      finest_substep_ = false;
       throw NumericalError(what.str());
     }
     ++substep_level_;

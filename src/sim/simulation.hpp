@@ -234,6 +234,8 @@ class Simulation {
   // their strain; FractureContext::untrusted_nodes).
   std::vector<std::vector<int>> step_fallback_nodes_;
   int substep_level_ = 0;
+  // True while the adaptive step runs its finest substep (no finer one left to retry with).
+  bool finest_substep_ = false;
   int steps_at_level_ = 0;
   // With adaptive_time_step: how far the last dynamics step's collision response moved a cloth node (m), and
   // which (cloth, node).
