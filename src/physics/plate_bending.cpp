@@ -21,21 +21,17 @@ Mat3 plate_bending_matrix(const std::array<double, 3>& lengths, const std::array
   return Q;
 }
 
-namespace {
-
-// Element slots of the hinge of edge i, in dihedral_angle's order: (c_i, c_i+1, c_i+2, w_i). The face itself is
-// the hinge's first face, in which the edge runs c_i -> c_i+1 counter-clockwise.
-std::array<int, 4> hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 + i}; }
-
-}  // namespace
+double hinge_angle_deviation(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double rest_theta) {
+  return wrap_angle(dihedral_angle(x0, x1, x2, x3) - rest_theta);
+}
 
 double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                             const Vec3& rest_theta, const Mat3& Q) {
   Vec3 delta = Vec3::Zero();
   for (int i = 0; i < 3; ++i) {
     if (!has_wing[i]) continue;
-    const auto s = hinge_slots(i);
-    delta[i] = wrap_angle(dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]) - rest_theta[i]);
+    const auto s = plate_hinge_slots(i);
+    delta[i] = hinge_angle_deviation(x[s[0]], x[s[1]], x[s[2]], x[s[3]], rest_theta[i]);
   }
   return delta.dot(Q * delta);
 }
@@ -48,16 +44,16 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
   for (int i = 0; i < 3; ++i) {
     grad[i].setZero();
     if (!has_wing[i]) continue;
-    const auto s = hinge_slots(i);
+    const auto s = plate_hinge_slots(i);
     out.theta[i] = dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
-    delta[i] = wrap_angle(out.theta[i] - rest_theta[i]);
+    delta[i] = wrap_angle(out.theta[i] - rest_theta[i]);  // hinge_angle_deviation, with the angle kept
     grad[i] = dihedral_angle_gradient(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
   }
   const Vec3 Qd = Q * delta;
   out.energy = delta.dot(Qd);
   for (int i = 0; i < 3; ++i) {
     if (!has_wing[i]) continue;
-    const auto s = hinge_slots(i);
+    const auto s = plate_hinge_slots(i);
     for (int a = 0; a < 4; ++a) out.gradient.segment<3>(3 * s[a]) += 2 * Qd[i] * grad[i].segment<3>(3 * a);
   }
   if (hessian == HessianKind::kNone) return out;
@@ -70,7 +66,7 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
   for (Mat3& g : G) g.setZero();
   for (int i = 0; i < 3; ++i) {
     if (!has_wing[i]) continue;
-    const auto s = hinge_slots(i);
+    const auto s = plate_hinge_slots(i);
     for (int a = 0; a < 4; ++a) G[s[a]].col(i) = grad[i].segment<3>(3 * a);
   }
   std::array<Mat3, 6> GQ;
@@ -88,7 +84,7 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
     // Curvature part 2 sum_i (Q d)_i d2(theta_i).
     for (int i = 0; i < 3; ++i) {
       if (!has_wing[i] || Qd[i] == 0) continue;
-      const auto s = hinge_slots(i);
+      const auto s = plate_hinge_slots(i);
       const Mat12 H = dihedral_angle_hessian(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)

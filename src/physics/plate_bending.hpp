@@ -35,6 +35,14 @@ using Mat18 = Eigen::Matrix<double, 18, 18>;
 Mat3 plate_bending_matrix(const std::array<double, 3>& lengths, const std::array<Vec3, 3>& normals, double area,
                           double kb, double nu, const std::array<bool, 3>& has_edge);
 
+// Element slots of the hinge of edge i, in dihedral_angle's order (mesh/mesh.hpp): corners c_i, c_i+1, c_i+2,
+// then wing w_i. The face is the hinge's first face, in which the edge runs c_i -> c_i+1 counter-clockwise.
+inline std::array<int, 4> plate_hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 + i}; }
+
+// The hinge's dihedral angle minus its rest angle, wrapped into (-pi, pi] (rad). Every evaluation of the plate
+// energy (physics, energy checks, reprojection's local solve) takes its deviations from here.
+double hinge_angle_deviation(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double rest_theta);
+
 struct PlateBendingTerms {
   double energy = 0;             // J
   Vec18 gradient = Vec18::Zero();  // N, stacked (c0, c1, c2, w0, w1, w2)

@@ -7,15 +7,12 @@
 #include "physics/bending.hpp"
 #include "physics/face_element.hpp"
 #include "physics/membrane.hpp"
-#include "mesh/mesh.hpp"  // dihedral_angle
+#include "physics/plate_bending.hpp"
+#include "mesh/mesh.hpp"  // dihedral_angle_gradient
 
 namespace arcsim {
 
 namespace {
-
-// Element slots of the hinge of edge i, in dihedral_angle's order (plate_bending.hpp): corners i, i+1, i+2,
-// then wing i.
-std::array<int, 4> hinge_slots(int i) { return {i, (i + 1) % 3, (i + 2) % 3, 3 + i}; }
 
 // A bending element as the node's solve sees it. The hinges that do not contain the node keep their angle
 // while it moves: their deviations are computed once (WHY: the solve evaluates its ~12 bending elements up to
@@ -44,12 +41,12 @@ Elements gather_elements(const Mesh& mesh, const std::vector<Material>& material
     b.el = make_bending_element(mesh, materials, f);
     for (int i = 0; i < 3; ++i) {
       if (!b.el.has_wing[i]) continue;
-      const auto s = hinge_slots(i);
+      const auto s = plate_hinge_slots(i);
       for (int k : s) b.moves[i] = b.moves[i] || b.el.nodes[k] == node;
       if (!b.moves[i]) {
         const Vec3 &x0 = mesh.nodes[b.el.nodes[s[0]]].x, &x1 = mesh.nodes[b.el.nodes[s[1]]].x,
                    &x2 = mesh.nodes[b.el.nodes[s[2]]].x, &x3 = mesh.nodes[b.el.nodes[s[3]]].x;
-        b.fixed_delta[i] = wrap_angle(dihedral_angle(x0, x1, x2, x3) - b.el.rest_theta[i]);
+        b.fixed_delta[i] = hinge_angle_deviation(x0, x1, x2, x3, b.el.rest_theta[i]);
       }
     }
     els.bending.push_back(b);
@@ -91,10 +88,10 @@ LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3
     std::array<Vec12, 3> grad;
     for (int i = 0; i < 3; ++i) {
       if (!nb.moves[i]) continue;
-      const auto s = hinge_slots(i);
+      const auto s = plate_hinge_slots(i);
       const Vec3 &x0 = position(b.nodes[s[0]]), &x1 = position(b.nodes[s[1]]), &x2 = position(b.nodes[s[2]]),
                  &x3 = position(b.nodes[s[3]]);
-      delta[i] = wrap_angle(dihedral_angle(x0, x1, x2, x3) - b.rest_theta[i]);
+      delta[i] = hinge_angle_deviation(x0, x1, x2, x3, b.rest_theta[i]);
       if (with_derivatives) grad[i] = dihedral_angle_gradient(x0, x1, x2, x3);
     }
     const Vec3 Qd = b.Q * delta;
@@ -106,7 +103,7 @@ LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3
       Vec3 slot_gradient = Vec3::Zero();
       for (int i = 0; i < 3; ++i) {
         if (!nb.moves[i]) continue;
-        const auto s = hinge_slots(i);
+        const auto s = plate_hinge_slots(i);
         for (int a = 0; a < 4; ++a)
           if (s[a] == p) slot_gradient += 2 * Qd[i] * grad[i].segment<3>(3 * a);
       }
@@ -116,7 +113,7 @@ LocalEnergy evaluate(const Mesh& mesh, const Elements& els, int node, const Vec3
     for (int i = 0; i < 3; ++i) {
       a[i].setZero();
       if (!nb.moves[i]) continue;
-      const auto s = hinge_slots(i);
+      const auto s = plate_hinge_slots(i);
       for (int k = 0; k < 4; ++k)
         if (b.nodes[s[k]] == node) a[i] += grad[i].segment<3>(3 * k);
     }
