@@ -108,7 +108,6 @@ class CandidateFinder {
  private:
   int mesh_of_face(int f) const { return g_.node_mesh[g_.faces[f][0]]; }
 
-
   bool moved(int n) const { return !options_.moved || (*options_.moved)[n]; }
   bool any_moved(const std::array<int, 2>& e) const { return moved(e[0]) || moved(e[1]); }
   bool any_moved(const std::array<int, 3>& f) const { return moved(f[0]) || moved(f[1]) || moved(f[2]); }
