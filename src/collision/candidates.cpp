@@ -55,6 +55,17 @@ class CandidateFinder {
       b.inflate(0.5 * options.margin);
       node_box_[n] = b;
     }
+    // Each face's and edge's box once: a face pair's tests ask for them again and again.
+    face_box_.resize(g.faces.size());
+    for (size_t f = 0; f < g.faces.size(); ++f)
+      if (g.faces[f][0] != kNone)
+        for (int n : g.faces[f]) face_box_[f].extend(node_box_[n]);
+    edge_box_.resize(g.edges.size());
+    for (size_t e = 0; e < g.edges.size(); ++e)
+      if (g.edges[e][0] != kNone) {
+        edge_box_[e] = node_box_[g.edges[e][0]];
+        edge_box_[e].extend(node_box_[g.edges[e][1]]);
+      }
     if (options.vertex_edge) {
       on_boundary_.assign(g.node_count(), 0);
       for (size_t e = 0; e < g.edges.size(); ++e)
@@ -63,13 +74,7 @@ class CandidateFinder {
     }
   }
 
-  std::vector<Aabb> face_boxes() const {
-    std::vector<Aabb> boxes(g_.faces.size());
-    for (size_t f = 0; f < g_.faces.size(); ++f)
-      if (g_.faces[f][0] != kNone)
-        for (int n : g_.faces[f]) boxes[f].extend(node_box_[n]);
-    return boxes;
-  }
+  const std::vector<Aabb>& face_boxes() const { return face_box_; }
 
   // Per face of mesh range r: has a moved node (only with options.moved).
   std::vector<char> moved_faces(const ContactGeometry::Range& r) const {
@@ -86,11 +91,11 @@ class CandidateFinder {
     vertices_against_face(fb, fa, out);
     for (int k = g_.owned_edge_begin[fa]; k < g_.owned_edge_begin[fa + 1]; ++k) {
       const int ea = g_.owned_edges[k];
-      const Aabb box_a = edge_box(ea);
+      const Aabb& box_a = edge_box_[ea];
       for (int l = g_.owned_edge_begin[fb]; l < g_.owned_edge_begin[fb + 1]; ++l) {
         const int eb = g_.owned_edges[l];
         if (!any_moved(g_.edges[ea]) && !any_moved(g_.edges[eb])) continue;
-        if (share_node(g_.edges[ea], g_.edges[eb]) || !box_a.overlaps(edge_box(eb))) continue;
+        if (share_node(g_.edges[ea], g_.edges[eb]) || !box_a.overlaps(edge_box_[eb])) continue;
         out.push_back({PairKind::kEdgeEdge, std::min(ea, eb), std::max(ea, eb)});
       }
     }
@@ -103,23 +108,12 @@ class CandidateFinder {
  private:
   int mesh_of_face(int f) const { return g_.node_mesh[g_.faces[f][0]]; }
 
-  Aabb edge_box(int e) const {
-    Aabb b = node_box_[g_.edges[e][0]];
-    b.extend(node_box_[g_.edges[e][1]]);
-    return b;
-  }
-  Aabb face_box(int f) const {
-    Aabb b;
-    for (int n : g_.faces[f]) b.extend(node_box_[n]);
-    return b;
-  }
-
   bool moved(int n) const { return !options_.moved || (*options_.moved)[n]; }
   bool any_moved(const std::array<int, 2>& e) const { return moved(e[0]) || moved(e[1]); }
   bool any_moved(const std::array<int, 3>& f) const { return moved(f[0]) || moved(f[1]) || moved(f[2]); }
 
   void vertices_against_face(int owner, int face, std::vector<PrimitivePair>& out) const {
-    const Aabb box = face_box(face);
+    const Aabb& box = face_box_[face];
     const bool face_moved = any_moved(g_.faces[face]);
     for (int k = g_.owned_node_begin[owner]; k < g_.owned_node_begin[owner + 1]; ++k) {
       const int n = g_.owned_nodes[k];
@@ -137,7 +131,7 @@ class CandidateFinder {
         const int e = g_.owned_edges[l];
         if (!moved(n) && !any_moved(g_.edges[e])) continue;
         if (!g_.is_boundary_edge(e) || g_.edges[e][0] == n || g_.edges[e][1] == n) continue;
-        if (!node_box_[n].overlaps(edge_box(e))) continue;
+        if (!node_box_[n].overlaps(edge_box_[e])) continue;
         out.push_back({PairKind::kVertexEdge, n, e});
       }
     }
@@ -146,6 +140,7 @@ class CandidateFinder {
   const ContactGeometry& g_;
   const CandidateOptions& options_;
   std::vector<Aabb> node_box_;
+  std::vector<Aabb> face_box_, edge_box_;
   std::vector<char> on_boundary_;
 };
 

@@ -335,7 +335,7 @@ double assemble_internal(const Mesh& mesh, const ElementCache& cache, const Inte
 void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
                              const ExternalLoads& loads, double dt, BlockSystem& system,
-                             Linearisation linearisation) {
+                             Linearisation linearisation, std::vector<CompactWindForce>* wind) {
   // Backward Euler linearised once (ARCSim): with H the PSD stiffness, beta the damping coefficient,
   //   (M + dt (dt + beta) H - dt D_v) dv = dt [ f - (dt + beta) H v + f_ext ]
   // where D_v is the velocity Jacobian of air drag. Units: blocks in kg, rhs in N s.
@@ -363,12 +363,15 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
     const double prediction = newton ? 0 : dt;
     system.rhs.segment<3>(3 * d) += dt * (-s.stiffness * (node.x - s.target) - prediction * s.stiffness * node.v);
   }
+  if (wind) wind->clear();
   if (loads.wind.density != 0 || loads.wind.drag != 0) {
+    if (wind) wind->reserve(faces.size());
     for (const auto& el : faces) {
       const WindForce w = wind_force(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x,
                                      mesh.nodes[el.nodes[2]].x, mesh.nodes[el.nodes[0]].v,
                                      mesh.nodes[el.nodes[1]].v, mesh.nodes[el.nodes[2]].v, loads.wind.velocity,
                                      loads.wind.density, loads.wind.drag);
+      if (wind) wind->push_back(CompactWindForce::of(w));
       system.add_element<3>(el.dofs, el.blocks, w.jacobian, -dt);
       for (int i = 0; i < 3; ++i)
         if (el.dofs[i] >= 0) system.rhs.segment<3>(3 * el.dofs[i]) += dt * w.force.segment<3>(3 * i);
@@ -420,8 +423,32 @@ namespace {
 // past the thickness) and friction dissipation dt c |(I - n n^T) u|^2 / 2, and the wind as linearised in the
 // system. Rayleigh damping, a quadratic in v, is added by step_fraction when it is needed.
 // `magnitude` (J) gets the sum of the terms' absolute values, the scale of the sum's rounding.
+// The wind's part is face e's -dt (alpha wind.linear[e] + alpha^2 wind.quadratic[e] / 2) (StepWind).
+struct StepWind {
+  std::vector<double> linear;     // f_e . dv_e (N m/s)
+  std::vector<double> quadratic;  // dv_e . J_e dv_e (kg m^2/s^3)
+};
+
+// The wind terms of the faces' air forces as assembled, f_e and J_e (their velocity Jacobian), along dv_e, the
+// faces' nodes' rows of dv. alpha dv_e's terms are alpha and alpha^2 times these, exactly for alpha a power of
+// two (step_fraction's), so step_potential gets the same sums as from the forces themselves.
+StepWind step_wind(const ElementCache& cache, const std::vector<CompactWindForce>& wind, const VecX& dv) {
+  StepWind out;
+  out.linear.resize(wind.size());
+  out.quadratic.resize(wind.size());
+  for (size_t e = 0; e < wind.size(); ++e) {
+    const FaceElement& el = cache.faces[e];
+    const WindForce w = wind[e].expand();
+    Vec9 change;
+    for (int i = 0; i < 3; ++i) change.segment<3>(3 * i) = dv.segment<3>(3 * el.nodes[i]);
+    out.linear[e] = w.force.dot(change);
+    out.quadratic[e] = change.dot(w.jacobian * change);
+  }
+  return out;
+}
+
 double step_potential(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads, double dt,
-                      const VecX& dv, double alpha, double* magnitude = nullptr) {
+                      const StepWind& wind, const VecX& dv, double alpha, double* magnitude = nullptr) {
   const int n = static_cast<int>(mesh.nodes.size());
   std::vector<Vec3> v(n), x(n);
   double potential = 0, signed_terms = 0;  // signed_terms: gravity and wind
@@ -450,17 +477,9 @@ double step_potential(const Mesh& mesh, const ElementCache& cache, const Externa
     }
     potential += 0.5 * dt * c.friction_damping * (u - c.normal * c.normal.dot(u)).squaredNorm();
   }
-  if (loads.wind.density != 0 || loads.wind.drag != 0) {
-    for (const auto& el : cache.faces) {
-      const WindForce w = wind_force(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x,
-                                     mesh.nodes[el.nodes[2]].x, mesh.nodes[el.nodes[0]].v,
-                                     mesh.nodes[el.nodes[1]].v, mesh.nodes[el.nodes[2]].v, loads.wind.velocity,
-                                     loads.wind.density, loads.wind.drag);
-      Vec9 change;
-      for (int i = 0; i < 3; ++i) change.segment<3>(3 * i) = alpha * dv.segment<3>(3 * el.nodes[i]);
-      signed_terms -= dt * (w.force.dot(change) + 0.5 * change.dot(w.jacobian * change));
-    }
-  }
+  const double alpha2 = alpha * alpha;
+  for (size_t e = 0; e < wind.linear.size(); ++e)
+    signed_terms -= dt * (alpha * wind.linear[e] + 0.5 * (alpha2 * wind.quadratic[e]));
   // Every other term is >= 0 except a released contact's linear one; gravity and wind carry a sign.
   if (magnitude) *magnitude = std::abs(potential) + std::abs(signed_terms);
   return potential + signed_terms;
@@ -476,13 +495,14 @@ double step_potential(const Mesh& mesh, const ElementCache& cache, const Externa
 // swinging it out of the plane by 1/sin(fold) as far (1 cm on 1 cm edges in tests/stress/foil_crumple_test.cpp's
 // case at 50 steps a frame: 55 J of elastic energy from one step, released as plastic work).
 double step_fraction(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads, double dt,
-                     const VecX& dv, double predicted) {
+                     const std::vector<CompactWindForce>& air, const VecX& dv, double predicted) {
+  const StepWind wind = step_wind(cache, air, dv);
   double magnitude = 0;
-  const double start = step_potential(mesh, cache, loads, dt, dv, 0, &magnitude);
+  const double start = step_potential(mesh, cache, loads, dt, wind, dv, 0, &magnitude);
   // Rounding of the sums (~1e-16 of each term) must not shorten a step.
   const double allowed = std::max(predicted, 0.0) + 1e-9 * magnitude;
   auto lowers = [&](double from, double value) { return value <= from + allowed; };
-  if (lowers(start, step_potential(mesh, cache, loads, dt, dv, 1))) return 1;  // the usual case
+  if (lowers(start, step_potential(mesh, cache, loads, dt, wind, dv, 1))) return 1;  // the usual case
   // Only now the damping potential dt/2 v^T B v, B = sum of beta_e H_e at x_n as the system has it: a
   // damped step may raise the rest of the potential by less than it lowers this part.
   BlockSystem damping;
@@ -502,7 +522,7 @@ double step_fraction(const Mesh& mesh, const ElementCache& cache, const External
   const double full_start = start + damping_potential(0);
   double alpha = 1;
   for (int k = 0; k <= kMaxHalvings; ++k) {
-    if (lowers(full_start, step_potential(mesh, cache, loads, dt, dv, alpha) + damping_potential(alpha)))
+    if (lowers(full_start, step_potential(mesh, cache, loads, dt, wind, dv, alpha) + damping_potential(alpha)))
       return alpha;
     alpha *= 0.5;
   }
@@ -521,7 +541,9 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
   ensure_pattern(cache);
   BlockSystem system;
   system.reset(cache.pattern);
-  assemble_implicit_euler(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system);
+  std::vector<CompactWindForce> wind;
+  assemble_implicit_euler(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system,
+                          Linearisation::kStep, &wind);
   if (!loads.pinned.empty()) {
     // Dirichlet: zero the pinned rows and columns, unit diagonal, zero right-hand side (dv = 0).
     for (int k = 0; k < cache.pattern.block_count(); ++k) {
@@ -540,7 +562,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
                                      solver.failed_row());
   });
   // The linear model's decrease of the potential: b.dv - dv.A dv / 2 = b.dv / 2 (A dv = b).
-  const double alpha = step_fraction(mesh, cache, loads, dt, dv, 0.5 * system.rhs.dot(dv));
+  const double alpha = step_fraction(mesh, cache, loads, dt, wind, dv, 0.5 * system.rhs.dot(dv));
   for (int i = 0; i < n; ++i) {
     Node& node = mesh.nodes[i];
     const Vec3 change = alpha * dv.segment<3>(3 * i);

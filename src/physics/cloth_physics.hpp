@@ -14,6 +14,7 @@
 #include "physics/face_element.hpp"
 #include "physics/material.hpp"
 #include "physics/system_dofs.hpp"
+#include "physics/wind.hpp"
 #include "scene/scene.hpp"
 
 namespace arcsim {
@@ -131,12 +132,14 @@ struct StepTiming {
 // iteration of backward Euler started from rest, with the mesh at the iterate (x_k = x_0 + dt v_k, v = v_k):
 // the same matrix, right-hand side dt [f(x_k) - beta H v_k + f_ext] - M v_k (no prediction terms), so the
 // solution is the correction of v_k. Contacts are linearised as in the step either way.
+// `wind`, if given, gets each face's air force as assembled (empty when there is no wind or drag).
 enum class Linearisation { kStep, kNewtonFromRest };
 
 void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
                              const ExternalLoads& loads, double dt, BlockSystem& system,
-                             Linearisation linearisation = Linearisation::kStep);
+                             Linearisation linearisation = Linearisation::kStep,
+                             std::vector<CompactWindForce>* wind = nullptr);
 
 // Solves the assembled system for dv (CholeskySolver::solve_system: factorised, or by conjugate gradients with a
 // kept factorisation for large systems), adding the wall times and the solve's report to `timing`. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the

@@ -14,6 +14,27 @@ struct WindForce {
   Mat9 jacobian = Mat9::Zero();  // d force / d (v0, v1, v2) (kg/s); symmetric negative semi-definite
 };
 
+// A WindForce held in 12 numbers: wind_force gives every node the same force and every 3x3 block of the
+// Jacobian the same matrix, so expand() rebuilds the WindForce it was taken from exactly.
+struct CompactWindForce {
+  Vec3 node_force = Vec3::Zero();  // N, each node's
+  Mat3 block = Mat3::Zero();       // kg/s, each block of the Jacobian
+  static CompactWindForce of(const WindForce& w) {
+    CompactWindForce c;
+    c.node_force = w.force.segment<3>(0);
+    c.block = w.jacobian.block<3, 3>(0, 0);
+    return c;
+  }
+  WindForce expand() const {
+    WindForce w;
+    for (int a = 0; a < 3; ++a) {
+      w.force.segment<3>(3 * a) = node_force;
+      for (int b = 0; b < 3; ++b) w.jacobian.block<3, 3>(3 * a, 3 * b) = block;
+    }
+    return w;
+  }
+};
+
 // Force on the face (x0, x1, x2) (m) with node velocities v0, v1, v2 (m/s). The Jacobian is with respect to
 // the node velocities at fixed positions, so the implicit solver can treat drag implicitly.
 WindForce wind_force(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& v0, const Vec3& v1,

@@ -262,5 +262,39 @@ TEST(ImplicitEuler, FoldedBorderNodeDoesNotSwingOutOfPlane) {
   EXPECT_LE(energy, 2 * bound) << "p moved " << (mesh.nodes[0].x - p).transpose();
 }
 
+// The assembly hands the step its faces' air forces (the step's energy check reuses them rather than
+// recomputing them): one per face, as wind_force gives it at the step's start; none without wind or drag.
+TEST(ImplicitEuler, AssemblyReportsTheFacesWindForces) {
+  Sheet s(testing::make_grid(4, 3, 0.3, 0.2, testing::Diagonal::kAlternating));
+  for (size_t i = 0; i < s.mesh.nodes.size(); ++i) s.mesh.nodes[i].v = Vec3(0.1 * i, -0.05, 0.2 + 0.01 * i);
+  ExternalLoads loads;
+  loads.wind.velocity = Vec3(1, 0.5, 2);
+  loads.wind.density = 1.2;
+  loads.wind.drag = 0.3;
+  const int n = static_cast<int>(s.mesh.nodes.size());
+  BlockSystem system;
+  system.reset(s.cache.pattern);
+  std::vector<CompactWindForce> wind;
+  assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, SystemDofs::all_nodes(n), loads, 0.01, system,
+                          Linearisation::kStep, &wind);
+  ASSERT_EQ(wind.size(), s.cache.faces.size());
+  for (size_t e = 0; e < wind.size(); ++e) {
+    const auto& el = s.cache.faces[e];
+    const WindForce w = wind_force(s.mesh.nodes[el.nodes[0]].x, s.mesh.nodes[el.nodes[1]].x,
+                                   s.mesh.nodes[el.nodes[2]].x, s.mesh.nodes[el.nodes[0]].v,
+                                   s.mesh.nodes[el.nodes[1]].v, s.mesh.nodes[el.nodes[2]].v, loads.wind.velocity,
+                                   loads.wind.density, loads.wind.drag);
+    const WindForce got = wind[e].expand();
+    EXPECT_TRUE(got.force == w.force) << "face " << e;
+    EXPECT_TRUE(got.jacobian == w.jacobian) << "face " << e;
+  }
+  loads.wind.density = 0;
+  loads.wind.drag = 0;
+  system.reset(s.cache.pattern);
+  assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, SystemDofs::all_nodes(n), loads, 0.01, system,
+                          Linearisation::kStep, &wind);
+  EXPECT_TRUE(wind.empty());
+}
+
 }  // namespace
 }  // namespace arcsim
