@@ -125,10 +125,12 @@ std::vector<Candidate> breaking_nodes(const Mesh& mesh, const std::vector<Materi
                                       const std::vector<int>& nodes, const std::vector<FaceFractureStress>& stress,
                                       const std::vector<char>& refused, const SeparationOptions& options) {
   std::vector<Candidate> out;
+  SeparationOptions only_breaking = options;
+  only_breaking.breaking_only = true;  // the others are dropped here
   for (int n : nodes) {
     if (n < 0 || n >= static_cast<int>(mesh.nodes.size()) || mesh.nodes[n].dead) continue;
     if (n < static_cast<int>(refused.size()) && refused[n]) continue;
-    NodeSeparation s = node_separation(mesh, materials, n, stress, options);
+    NodeSeparation s = node_separation(mesh, materials, n, stress, only_breaking);
     if (s.breaks()) out.push_back({std::move(s)});
   }
   std::sort(out.begin(), out.end());
@@ -295,14 +297,17 @@ std::vector<Candidate> predict(Mesh& mesh, const std::vector<Material>& material
   // stiff sheet moves its nodes along tangents, and the spurious stretch of order theta^2 / 2 alone exceeds a
   // brittle sheet's critical strain.
   // The zone's nodes carry the iterate: x_0 + dt v_k and v_k (Linearisation::kNewtonFromRest).
+  // The iterations change positions and velocities only: one zone system (elements, pattern and the solver's
+  // symbolic analysis) serves them all.
   const int iterations = std::max(params.virtual_iterations, 1);
   double previous = kInfinity;
+  ZoneSolveOptions zone_options;
+  zone_options.linearisation = Linearisation::kNewtonFromRest;
+  const ZoneSystem system(mesh, materials, zone, pass.loads, zone_options);
   for (int it = 0; it < iterations; ++it) {
-    ZoneSolveOptions zone_options;
-    zone_options.linearisation = Linearisation::kNewtonFromRest;
     ZoneSolution sol;
     try {
-      sol = solve_zone(mesh, materials, zone, pass.loads, context.dt, solver, zone_options);
+      sol = system.solve(mesh, pass.loads, context.dt, solver);
     } catch (const NumericalError&) {
       if (it == 0) moved.clear(), saved.clear();
       break;  // later iterations keep the last iterate

@@ -95,12 +95,14 @@ const FanPiece& piece_at(const UnfoldedFan& fan, double phi) {
   return fan.pieces.back();
 }
 
-// The sums over [0, phi], phi in [0, total].
-SectorSums sums_up_to(const UnfoldedFan& fan, double phi) {
+// The sums over [0, phi], phi in [0, total]; M = arc_antiderivative(phi).
+SectorSums sums_up_to(const UnfoldedFan& fan, double phi, const Vec2& M) {
   const FanPiece& p = piece_at(fan, phi);
-  const Vec2 arc = arc_antiderivative(phi) - p.start_antiderivative;
+  const Vec2 arc = M - p.start_antiderivative;
   return {p.before.arc + arc, p.before.traction + p.stress * arc};
 }
+
+SectorSums sums_up_to(const UnfoldedFan& fan, double phi) { return sums_up_to(fan, phi, arc_antiderivative(phi)); }
 
 int ray_count(const UnfoldedFan& fan) { return fan.closed ? 2 : 1; }
 
@@ -108,8 +110,9 @@ int ray_count(const UnfoldedFan& fan) { return fan.closed ? 2 : 1; }
 double ray_angle(const UnfoldedFan& fan, double phi, int k) { return k == 0 ? phi : phi + 0.5 * fan.total; }
 
 // The two sectors of the split at angle phi (interior: phi in [0, total / 2]); the second is the rest of the fan.
-std::array<SectorSums, 2> split_sectors(const UnfoldedFan& fan, double phi) {
-  SectorSums first = sums_up_to(fan, phi);
+// M = arc_antiderivative(phi), which the caller also needs (one sine and cosine for both).
+std::array<SectorSums, 2> split_sectors(const UnfoldedFan& fan, double phi, const Vec2& M) {
+  SectorSums first = sums_up_to(fan, phi, M);
   if (fan.closed) first = sums_up_to(fan, phi + 0.5 * fan.total) - first;
   return {first, fan.all - first};
 }
@@ -123,9 +126,10 @@ double common_traction(const Vec2& q1, const Vec2& q2) {
   return std::min(q1.dot(q_hat), -q2.dot(q_hat));
 }
 
-// Eq. 7 for the unit uniaxial stress n n^T across the split, n the normal of the (first) ray.
-double geometry_factor(const std::array<SectorSums, 2>& sectors, double phi) {
-  const Vec2 n(-std::sin(phi), std::cos(phi));
+// Eq. 7 for the unit uniaxial stress n n^T across the split, n the normal of the (first) ray at angle phi:
+// n = (-sin phi, cos phi) = -M, M = arc_antiderivative(phi).
+double geometry_factor(const std::array<SectorSums, 2>& sectors, const Vec2& M) {
+  const Vec2 n = -M;
   return common_traction(n * n.dot(sectors[0].arc), n * n.dot(sectors[1].arc));
 }
 
@@ -136,7 +140,8 @@ double geometry_factor_at(const UnfoldedFan& fan, double phi) {
     phi = std::fmod(std::fmod(phi, half) + half, half);
   }
   phi = std::clamp(phi, 0.0, fan.total);
-  return geometry_factor(split_sectors(fan, phi), phi);
+  const Vec2 M = arc_antiderivative(phi);
+  return geometry_factor(split_sectors(fan, phi, M), M);
 }
 
 // Maximises the geometry factor near a sampled maximum (its peak can be a kink, e.g. 1 - |cos phi| at a
@@ -188,8 +193,9 @@ BestPlane search_planes(const UnfoldedFan& fan, int samples, double step) {
   const int count = fan.closed ? (samples + 1) / 2 : samples;
   for (int i = 0; i < count; ++i) {
     const double phi = i * step;
-    const std::array<SectorSums, 2> sectors = split_sectors(fan, phi);
-    const double c = geometry_factor(sectors, phi);
+    const Vec2 M = arc_antiderivative(phi);
+    const std::array<SectorSums, 2> sectors = split_sectors(fan, phi, M);
+    const double c = geometry_factor(sectors, M);
     if (c > best.factor) best.factor = c, best.factor_phi = phi;
     if (c < kMinGeometryFactor || !rays_breakable(fan, phi)) continue;
     const double s = common_traction(sectors[0].traction, sectors[1].traction);
@@ -213,9 +219,6 @@ NodeSeparation node_separation(const Mesh& mesh, const std::vector<Material>& ma
   const double step = fan.total / samples;
   const BestPlane best = search_planes(fan, samples, step);
   if (!(best.raw > 0)) return out;
-  out.raw = best.raw;
-  out.factor = refined_geometry_factor(fan, best.factor_phi, step, best.factor);
-  out.strength = out.raw / out.factor;
   double tau_sum = 0;
   for (int k = 0; k < ray_count(fan); ++k) {
     const double a = wrapped(fan, ray_angle(fan, best.phi, k));
@@ -224,6 +227,16 @@ NodeSeparation node_separation(const Mesh& mesh, const std::vector<Material>& ma
     tau_sum += piece.toughness;
   }
   out.toughness = tau_sum / out.rays.size();
+  // The refined factor is at least the sampled one, so raw / sampled bounds the strength from above (in floating
+  // point too: the refinement returns the larger of the two).
+  if (options.breaking_only && !(out.toughness > 0 && best.raw / best.factor > out.toughness)) {
+    out.rays.clear();
+    out.toughness = 0;
+    return out;
+  }
+  out.raw = best.raw;
+  out.factor = refined_geometry_factor(fan, best.factor_phi, step, best.factor);
+  out.strength = out.raw / out.factor;
   return out;
 }
 

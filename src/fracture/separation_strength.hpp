@@ -65,6 +65,10 @@ struct NodeSeparation {
 
 struct SeparationOptions {
   int samples = 200;
+  // For callers that keep only the nodes that break: a node whose sampled bound (raw over the sampled geometry
+  // factor, which the refined factor can only raise) shows that it does not break returns as a skipped node
+  // (strength 0, no rays) without refining its factor. Breaking nodes get the full result.
+  bool breaking_only = false;
 };
 
 // The separation strength of `node` and its best plane, from the faces' sigma+ (indexed like mesh.faces).

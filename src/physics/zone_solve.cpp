@@ -66,37 +66,22 @@ std::vector<int> node_rings(const Mesh& mesh, const std::vector<int>& nodes, int
   return reached;
 }
 
-ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials,
-                        const std::vector<int>& zone_nodes, const ExternalLoads& loads, double dt,
-                        CholeskySolver& solver, const ZoneSolveOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  ZoneSolution out;
+ZoneSystem::ZoneSystem(const Mesh& mesh, const std::vector<Material>& materials,
+                       const std::vector<int>& zone_nodes, const ExternalLoads& loads,
+                       const ZoneSolveOptions& options)
+    : options_(options) {
   const int node_count = static_cast<int>(mesh.nodes.size());
   // The zone's live nodes; its free nodes (the system's rows) are those the loads do not pin (a pinned node
   // keeps its velocity, as in the full step).
   for (int n : zone_nodes)
-    if (n >= 0 && n < node_count && !mesh.nodes[n].dead) out.nodes.push_back(n);
-  sort_unique(out.nodes);
+    if (n >= 0 && n < node_count && !mesh.nodes[n].dead) nodes_.push_back(n);
+  sort_unique(nodes_);
   std::vector<int> free_nodes;
   // Nodes past the end of `pinned` were added by edits after the loads were made (fracture's openings): free.
-  for (int n : out.nodes)
+  for (int n : nodes_)
     if (n >= static_cast<int>(loads.pinned.size()) || !loads.pinned[n]) free_nodes.push_back(n);
-  const SystemDofs dofs = SystemDofs::only(free_nodes);
-  const size_t count = out.nodes.size();
-  out.dv.assign(count, Vec3::Zero());
-  out.v.resize(count);
-  out.x.resize(count);
-  auto finish = [&] {
-    for (size_t i = 0; i < count; ++i) {
-      const Node& node = mesh.nodes[out.nodes[i]];
-      out.v[i] = node.v + out.dv[i];
-      out.x[i] = node.x + dt * out.v[i];
-    }
-  };
-  if (free_nodes.empty()) {
-    finish();
-    return out;
-  }
+  dofs_ = SystemDofs::only(free_nodes);
+  if (free_nodes.empty()) return;
 
   // The zone's elements: faces around a free node (membrane) and, for bending, also the faces that have a free
   // node as a wing (across the edge opposite it). In face order, as the full step assembles them.
@@ -109,48 +94,75 @@ ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials
   sort_unique(membrane_faces);
   sort_unique(bending_faces);
 
-  std::vector<FaceElement> faces;
-  std::vector<BendingElement> bending;
-  faces.reserve(membrane_faces.size());
-  bending.reserve(bending_faces.size());
+  faces_.reserve(membrane_faces.size());
+  bending_.reserve(bending_faces.size());
   std::vector<std::pair<int, int>> pairs;
   std::vector<int> support;
-  for (int f : membrane_faces) faces.push_back(with_zone_rows(make_face_element(mesh, materials, f), dofs, pairs));
+  for (int f : membrane_faces) faces_.push_back(with_zone_rows(make_face_element(mesh, materials, f), dofs_, pairs));
   for (int f : bending_faces) {
-    bending.push_back(with_zone_rows(make_bending_element(mesh, materials, f), dofs, pairs));
+    bending_.push_back(with_zone_rows(make_bending_element(mesh, materials, f), dofs_, pairs));
     for (int i = 0; i < 6; ++i)
-      if (bending.back().dofs[i] < 0) support.push_back(bending.back().nodes[i]);
+      if (bending_.back().dofs[i] < 0) support.push_back(bending_.back().nodes[i]);
   }
-  for (const ContactTerm& c : loads.contacts) add_dof_pairs(dofs_of(c.nodes, dofs), pairs);
+  for (const ContactTerm& c : loads.contacts) add_dof_pairs(dofs_of(c.nodes, dofs_), pairs);
 
-  BlockPattern pattern;
-  pattern.build(dofs.count(), std::move(pairs));
-  for (FaceElement& el : faces) el.blocks = element_block_ids<3>(pattern, el.dofs);
-  for (BendingElement& el : bending) el.blocks = element_block_ids<6>(pattern, el.dofs);
+  pattern_.build(dofs_.count(), std::move(pairs));
+  for (FaceElement& el : faces_) el.blocks = element_block_ids<3>(pattern_, el.dofs);
+  for (BendingElement& el : bending_) el.blocks = element_block_ids<6>(pattern_, el.dofs);
+
+  // Support: the n-ring around the zone and every fixed node the zone's elements read.
+  for (int n : node_rings(mesh, nodes_, std::max(options.support_rings, 1))) support.push_back(n);
+  for (const FaceElement& el : faces_)
+    for (int i = 0; i < 3; ++i) support.push_back(el.nodes[i]);
+  sort_unique(support);
+  std::set_difference(support.begin(), support.end(), nodes_.begin(), nodes_.end(),
+                      std::back_inserter(support_nodes_));
+}
+
+ZoneSolution ZoneSystem::solve(const Mesh& mesh, const ExternalLoads& loads, double dt,
+                               CholeskySolver& solver) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  ZoneSolution out;
+  out.nodes = nodes_;
+  const size_t count = out.nodes.size();
+  out.dv.assign(count, Vec3::Zero());
+  out.v.resize(count);
+  out.x.resize(count);
+  auto finish = [&] {
+    for (size_t i = 0; i < count; ++i) {
+      const Node& node = mesh.nodes[out.nodes[i]];
+      out.v[i] = node.v + out.dv[i];
+      out.x[i] = node.x + dt * out.v[i];
+    }
+  };
+  if (dofs_.count() == 0) {
+    finish();
+    return out;
+  }
 
   BlockSystem system;
-  system.reset(pattern);
-  assemble_implicit_euler(mesh, faces, bending, dofs, loads, dt, system, options.linearisation);
+  system.reset(pattern_);
+  assemble_implicit_euler(mesh, faces_, bending_, dofs_, loads, dt, system, options_.linearisation);
   out.timing.assembly = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const VecX dv = factor_and_solve(solver, system, "zone step", out.timing, [&] {
-    return explain_indefinite_system(mesh, faces, bending, dofs, loads, dt, system, solver.failed_row());
+    return explain_indefinite_system(mesh, faces_, bending_, dofs_, loads, dt, system, solver.failed_row());
   });
 
   for (size_t i = 0; i < count; ++i) {
-    const int d = dofs.dof(out.nodes[i]);
+    const int d = dofs_.dof(out.nodes[i]);
     if (d >= 0) out.dv[i] = dv.segment<3>(3 * d);
   }
   finish();
-  // Support: the n-ring around the zone and every fixed node the zone's elements read.
-  for (int n : node_rings(mesh, out.nodes, std::max(options.support_rings, 1))) support.push_back(n);
-  for (const FaceElement& el : faces)
-    for (int i = 0; i < 3; ++i) support.push_back(el.nodes[i]);
-  sort_unique(support);
-  std::set_difference(support.begin(), support.end(), out.nodes.begin(), out.nodes.end(),
-                      std::back_inserter(out.support_nodes));
-  out.face_elements = static_cast<int>(faces.size());
-  out.bending_elements = static_cast<int>(bending.size());
+  out.support_nodes = support_nodes_;
+  out.face_elements = static_cast<int>(faces_.size());
+  out.bending_elements = static_cast<int>(bending_.size());
   return out;
+}
+
+ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials,
+                        const std::vector<int>& zone_nodes, const ExternalLoads& loads, double dt,
+                        CholeskySolver& solver, const ZoneSolveOptions& options) {
+  return ZoneSystem(mesh, materials, zone_nodes, loads, options).solve(mesh, loads, dt, solver);
 }
 
 void apply_zone_solution(Mesh& mesh, const ZoneSolution& solution, double dt) {

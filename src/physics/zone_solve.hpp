@@ -20,7 +20,9 @@
 #include "mesh/mesh.hpp"
 #include "physics/block_system.hpp"
 #include "physics/cloth_physics.hpp"
+#include "physics/face_element.hpp"
 #include "physics/material.hpp"
+#include "physics/system_dofs.hpp"
 
 namespace arcsim {
 
@@ -54,6 +56,30 @@ struct ZoneSolution {
 ZoneSolution solve_zone(const Mesh& mesh, const std::vector<Material>& materials,
                         const std::vector<int>& zone_nodes, const ExternalLoads& loads, double dt,
                         CholeskySolver& solver, const ZoneSolveOptions& options = {});
+
+// The structure of one zone's system: its nodes and rows, its elements (which hold rest-state quantities only)
+// and their block pattern, built from the mesh's topology, rest state and the loads' pins and contacts. While
+// those stay as they are and only positions and velocities change (fracture's Newton iterations of a virtual
+// update), a zone solved repeatedly through one ZoneSystem builds them once, and the solver keeps the pattern's
+// symbolic analysis (its id does not change): the same solutions as solve_zone's, bit for bit.
+class ZoneSystem {
+ public:
+  ZoneSystem(const Mesh& mesh, const std::vector<Material>& materials, const std::vector<int>& zone_nodes,
+             const ExternalLoads& loads, const ZoneSolveOptions& options = {});
+  // solve_zone on the current positions and velocities. `loads` must pin the nodes and hold the contacts the
+  // system was built with (gravity, wind and spring anchors may differ).
+  ZoneSolution solve(const Mesh& mesh, const ExternalLoads& loads, double dt, CholeskySolver& solver) const;
+  const BlockPattern& pattern() const { return pattern_; }
+
+ private:
+  ZoneSolveOptions options_;
+  std::vector<int> nodes_;          // live zone nodes (sorted)
+  SystemDofs dofs_;
+  std::vector<FaceElement> faces_;
+  std::vector<BendingElement> bending_;
+  BlockPattern pattern_;
+  std::vector<int> support_nodes_;
+};
 
 // Writes a zone solution into the mesh as the full step does for every node: v += dv, a = dv/dt, x0 = x,
 // x += dt v, for the zone's nodes only.

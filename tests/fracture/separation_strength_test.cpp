@@ -165,6 +165,45 @@ TEST(SeparationStrength, UniaxialStressAtInteriorNodesOfAnyFan) {
   }
 }
 
+// breaking_only (fracture's candidate scan), at interior nodes under uniaxial stress: a breaking node gets the
+// full result bit for bit; a stressed node that does not break (past the cheap skip's half toughness, below its
+// toughness) is skipped without refining its factor: strength 0 and no rays, where the full evaluation reports
+// its strength.
+TEST(SeparationStrength, BreakingOnlySkipsNodesThatDoNotBreak) {
+  Fans fans(13);
+  SeparationOptions only_breaking;
+  only_breaking.breaking_only = true;
+  for (int n = 3; n <= 9; ++n) {
+    const Mesh mesh = fan_mesh(fans.irregular(n), true);
+    const double angle = fans.uniform(0, kPi);
+    const std::vector<FaceFractureStress> stress =
+        uniform_stress(mesh, uniaxial(kSigma, Vec2(std::cos(angle), std::sin(angle))));
+    SCOPED_TRACE("faces " + std::to_string(n));
+    // Toughness 1000 N/m: breaks (strength ~1500 N/m).
+    const NodeSeparation full = node_separation(mesh, materials(), 0, stress);
+    const NodeSeparation fast = node_separation(mesh, materials(), 0, stress, only_breaking);
+    ASSERT_TRUE(full.breaks());
+    EXPECT_TRUE(fast.breaks());
+    EXPECT_EQ(fast.strength, full.strength);
+    EXPECT_EQ(fast.raw, full.raw);
+    EXPECT_EQ(fast.factor, full.factor);
+    EXPECT_EQ(fast.toughness, full.toughness);
+    ASSERT_EQ(fast.rays.size(), full.rays.size());
+    for (size_t k = 0; k < full.rays.size(); ++k) {
+      EXPECT_EQ(fast.rays[k].face, full.rays[k].face);
+      EXPECT_EQ(fast.rays[k].direction, full.rays[k].direction);
+    }
+    // Toughness 2000 N/m: stressed past half of it (not skipped cheaply), does not break.
+    const NodeSeparation full_tough = node_separation(mesh, materials(2 * kToughness), 0, stress);
+    const NodeSeparation fast_tough = node_separation(mesh, materials(2 * kToughness), 0, stress, only_breaking);
+    EXPECT_FALSE(full_tough.breaks());
+    EXPECT_GT(full_tough.strength, 0);
+    EXPECT_FALSE(fast_tough.breaks());
+    EXPECT_EQ(fast_tough.strength, 0);
+    EXPECT_TRUE(fast_tough.rays.empty());
+  }
+}
+
 TEST(SeparationStrength, StretchedGridEndToEnd) {
   Mesh mesh = testing::make_grid(6, 6, 0.6, 0.6, testing::Diagonal::kAlternating);
   for (Face& f : mesh.faces) f.thickness = kThickness;
