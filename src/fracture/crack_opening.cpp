@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include "collision/triangle_intersection.hpp"
+
 namespace arcsim {
 namespace {
 
@@ -296,28 +298,74 @@ std::vector<std::vector<int>> sides_of(const Mesh& m, int node, const std::vecto
 // crack of the same pass, often coincident twins themselves) stays coincident with its twin; once a later edit
 // removes the node they share, their faces cross, and collision handling has no normal to separate them
 // (docs/repro/glass-plate-shards-coincident-lips.json: 66 such lips in one step, 191 crossing pairs).
-bool lips_can_part(const EditSession& session, int node, const std::vector<int>& crack_edges,
-                   const std::vector<int>& split_far_ends, double distance) {
+// Empty if they can, else why not.
+std::string lips_can_part(const EditSession& session, int node, const std::vector<int>& crack_edges,
+                          const std::vector<int>& split_far_ends, double distance) {
+  const std::string guard_refuses = "the lips could not be set apart (the world guard refuses their move)";
   const Mesh& m = session.mesh();
   std::vector<int> around = m.node_faces(node);
   for (int far : split_far_ends) {
     const std::vector<int> faces = m.node_faces(far);
     around.insert(around.end(), faces.begin(), faces.end());
   }
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
   std::vector<int> splitting{node};
   splitting.insert(splitting.end(), split_far_ends.begin(), split_far_ends.end());
-  for (int n : splitting) {
+  // Each face of `around` as it will be once the lips are set apart: its corners' positions and the nodes they
+  // will be (a split node's corner becomes the copy of its side: -1 - (its index in `splitting` * 8 + side)).
+  std::vector<std::array<Vec3, 3>> after(around.size());
+  std::vector<std::array<int, 3>> ids(around.size());
+  for (size_t i = 0; i < around.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      after[i][c] = m.nodes[m.face_node(around[i], c)].x;
+      ids[i][c] = m.face_node(around[i], c);
+    }
+  for (size_t k = 0; k < splitting.size(); ++k) {
+    const int n = splitting[k];
     const std::vector<int> all = m.node_faces(n);
-    for (const std::vector<int>& own : sides_of(m, n, crack_edges)) {
+    const std::vector<std::vector<int>> sides = sides_of(m, n, crack_edges);
+    for (size_t s = 0; s < sides.size(); ++s) {
+      const std::vector<int>& own = sides[s];
       const Vec3 d = lip_direction(m, own, all);
-      if (!(d.norm() > 0)) return false;
+      if (!(d.norm() > 0)) return guard_refuses;
       NodeMoveOptions options;
       options.exempt_faces = faces_besides(around, own);
       options.require_clearance = false;
-      if (!session.move_allowed(n, own, distance * d, options)) return false;
+      if (!session.move_allowed(n, own, distance * d, options)) return guard_refuses;
+      for (int f : own) {
+        const size_t i = std::lower_bound(around.begin(), around.end(), f) - around.begin();
+        const int c = m.corner_of_node(f, n);
+        after[i][c] += distance * d;
+        ids[i][c] = -1 - static_cast<int>(k * 8 + s);
+      }
     }
   }
-  return true;
+  // The guard does not check the lips against each other (they touch at the split nodes until the split), and
+  // moves that part each twin pair well can still leave the new lips crossing: where the crack reaches a
+  // border, the lip directions of the two ends can run mostly along the crack edge, in opposite senses, and the
+  // two lips' edges then cross in an X (f15 static ornament, step 4: 20 um apart along the edge, one lip over
+  // the other's face 0.1 um out of the surface), which no contact normal can part. So the faces around the
+  // split, moved as the lips will be, must not meet unless they still share a node after the split (nor, for
+  // faces that shared none before, meet where they did not meet before).
+  auto shares = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
+    for (int x : a)
+      if (std::find(b.begin(), b.end(), x) != b.end()) return true;
+    return false;
+  };
+  for (size_t i = 0; i < around.size(); ++i)
+    for (size_t j = i + 1; j < around.size(); ++j) {
+      if (shares(ids[i], ids[j]) || !triangles_intersect(after[i], after[j])) continue;
+      std::array<int, 3> ni, nj;
+      std::array<Vec3, 3> xi, xj;
+      for (int c = 0; c < 3; ++c) {
+        ni[c] = m.face_node(around[i], c), nj[c] = m.face_node(around[j], c);
+        xi[c] = m.nodes[ni[c]].x, xj[c] = m.nodes[nj[c]].x;
+      }
+      if (!shares(ni, nj) && triangles_intersect(xi, xj)) continue;  // crossing before: not the opening's
+      return "the lips would cross once set apart (faces of the split meet where they share no node)";
+    }
+  return "";
 }
 
 }  // namespace
@@ -359,8 +407,10 @@ CrackOpening open_crack(EditSession& session, int node, const std::vector<CutRay
     for (int f : m.node_faces(node))
       if (piece_faces(m, f, out.crack_edges, options.min_piece_faces) < options.min_piece_faces)
         return refuse(out, "the crack would cut off a piece of fewer than min_piece_faces faces");
-  if (options.lip_gap > 0 && !lips_can_part(session, node, out.crack_edges, split_far_ends, 0.5 * options.lip_gap))
-    return refuse(out, "the lips could not be set apart (the world guard refuses their move)");
+  if (options.lip_gap > 0) {
+    why = lips_can_part(session, node, out.crack_edges, split_far_ends, 0.5 * options.lip_gap);
+    if (!why.empty()) return refuse(out, why);
+  }
   const EditResult r = session.split_node(node, out.crack_edges);
   if (!r.ok) return refuse(out, "the edit session refused the node split");
   out.mesh_changed = true;

@@ -15,7 +15,10 @@
 // Refused when the cut would need a face or edge smaller than the sliver limits, follow an edge that is already
 // a border, put both rays on one edge, when a lip of the split could not be set lip_gap apart (checked through
 // the session's world guard before the node split: lips left coincident have no contact normal, and their faces
-// cross once a later edit removes the node they share), or the session refuses an edit; the reason is returned.
+// cross once a later edit removes the node they share), when the lips, set apart, would cross each other (where a
+// crack reaches a border, the twin pairs at its two ends can be set apart in directions that cross the two lips'
+// edges in an X, which no contact normal parts; checked before the split on the faces around it, moved as the
+// lips will be), or the session refuses an edit; the reason is returned.
 // A refused node is not tried again in the same fracture pass (fracture_step.hpp); the next step may retry it. Every check that
 // needs no edit runs on all rays before the first edit, so a refusal normally changes nothing. Only when the
 // session refuses a later step after the first ray's edge split succeeded (or the second ray's plan changes

@@ -243,6 +243,54 @@ TEST(CrackOpening, OpeningWhoseLipsCannotPartIsRefusedBeforeTheSplit) {
   }
 }
 
+// Lips that would cross once set apart are refused before the split (docs/stability.md, 2026-12-06 (h4)). A crack
+// from border node N straight to border node F (the crack reaches the border: F is split too). F's fan is
+// lopsided: the lower lip's faces wrap around F (280 degrees) and the last two are large, so that lip's centroid
+// lies above the upper lip's, and each half of F is set apart along its lip's centroid direction (away from the
+// other half) with the wrong sign across the crack. At N the lips part the right way: the two lips' edges cross in an
+// X, their faces overlap in the plane, and no contact normal parts them (conf/paper-ornament-static.json at
+// frequency 15, step 4: the opening at node 3618 reaching 3396 left two lip faces crossing, exit 3 at step 5).
+// With the wrapped faces small the same opening opens without a crossing.
+TEST(CrackOpening, OpeningWhoseLipsWouldCrossIsRefusedBeforeTheSplit) {
+  const Material material = elastic_aluminium();
+  for (const bool lopsided : {true, false}) {
+    SCOPED_TRACE(lopsided ? "lopsided fan" : "even fan");
+    const double far = lopsided ? 3 : 1;  // radius of the last two wrapped nodes
+    auto at = [](double degrees, double radius) {
+      return Vec3(radius * std::cos(degrees * M_PI / 180), radius * std::sin(degrees * M_PI / 180), 0);
+    };
+    // F, N, U (upper lip), P1..P5 (lower lip, clockwise from N around F).
+    const std::vector<Vec3> x{Vec3(0, 0, 0), Vec3(1, 0, 0), at(45, 1),  at(-60, 1),
+                              at(-120, 1),   at(-180, 1),   at(-240, far), at(-280, far)};
+    const std::vector<std::array<int, 3>> tris{{0, 1, 2}, {0, 3, 1}, {0, 4, 3}, {0, 5, 4}, {0, 6, 5}, {0, 7, 6}};
+    std::vector<int> vert_node(x.size());
+    for (size_t i = 0; i < x.size(); ++i) vert_node[i] = static_cast<int>(i);
+    Mesh mesh = Mesh::from_triangles(x, x, vert_node, tris);
+    ASSERT_EQ(check_mesh(mesh), "");
+    const std::vector<Material> materials{material};
+    for (Face& f : mesh.faces) f.thickness = material.thickness;
+    EditSessionOptions o;
+    o.world_clearance = 1e-6;
+    EditSession session(mesh, materials, o);
+    CrackOpeningOptions crack = options_with_size(0.2);
+    crack.lip_gap = 2e-5;
+    crack.min_piece_faces = 1;
+    const int node = 1;  // N; the crack runs along the edge N -> F
+    const long nodes_before = static_cast<long>(mesh.nodes.size());
+    const CrackOpening opening = open_crack(session, node, {ray_along(mesh, node, Vec3(-1, 0, 0))}, crack);
+    EXPECT_EQ(check_mesh(mesh), "");
+    EXPECT_EQ(crossing_pairs(mesh), 0u) << "the lips cross";
+    if (lopsided) {
+      EXPECT_FALSE(opening.ok);
+      EXPECT_NE(opening.refused.find("lips would cross"), std::string::npos) << opening.refused;
+      EXPECT_EQ(static_cast<long>(mesh.nodes.size()), nodes_before) << "no node was split";
+    } else {
+      ASSERT_TRUE(opening.ok) << opening.refused;
+      EXPECT_EQ(opening.far_ends.size(), 1u);
+    }
+  }
+}
+
 // Largest principal Green strain (absolute) over the live faces, of the total deformation F or of the elastic
 // one F Fp.
 double largest_strain(const Mesh& mesh, bool elastic) {
