@@ -61,7 +61,8 @@ std::string frame_log_line(const FrameReport& r) {
         .integer("ill_conditioned_zones", z.ill_conditioned_zones)
         .integer("unresolved_steps", z.unresolved_steps)
         .number("work", z.work)
-        .number("largest_work", z.largest_work);
+        .number("largest_work", z.largest_work)
+        .integer("warnings", z.warnings);
     line.object("impact_zones", zones);
   }
   if (r.has_fracture) {

@@ -170,6 +170,16 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   report.residuals = sim.times.solver.residuals;
 }
 
+// The frame's collision warnings (the first few, and how many more), each on its own line.
+static void print_collision_warnings(const ImpactZoneTotals& totals, Progress& progress, const Console& console) {
+  if (totals.warnings == 0) return;
+  progress.end_line();
+  for (const std::string& w : totals.first_warnings) console.warn(w);
+  const long long more = totals.warnings - static_cast<long long>(totals.first_warnings.size());
+  if (more > 0) console.warn("collision: " + std::to_string(more) + " more warnings in this frame (log.jsonl: "
+                             "impact_zones.warnings counts them)");
+}
+
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {
   const ProgressStyle style = choose_progress_style(options.quiet, options.json_progress, console.err_is_terminal);
   Progress progress(style, console, sim.total_frames());
@@ -194,6 +204,7 @@ void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& optio
       report.wall.output = seconds_since(output_start);
       report.wall.total = seconds_since(frame_start);
       if (out) out->log(frame_log_line(report));
+      if (!options.quiet) print_collision_warnings(report.impact_zones, progress, console);
       progress.frame_done(report);
     }
   } catch (const NumericalError& e) {

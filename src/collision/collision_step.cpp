@@ -29,6 +29,9 @@ void ImpactZoneTotals::add(const ImpactZoneStats& s) {
   unresolved_steps += !s.resolved;
   work += s.work;
   largest_work = std::max(largest_work, s.work);
+  for (const std::string& w : s.warnings)
+    if (static_cast<int>(first_warnings.size()) < kMaxWarnings) first_warnings.push_back(w);
+  warnings += static_cast<long long>(s.warnings.size());
 }
 
 std::vector<std::vector<ContactTerm>> CollisionHandler::proximity_terms(const std::vector<const Mesh*>& cloths,

@@ -4,6 +4,7 @@
 // A CollisionHandler keeps the per-mesh BVHs between steps (rebuilt only when a topology changes).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "collision/candidates.hpp"
@@ -45,6 +46,10 @@ struct ImpactZoneTotals {
   int unresolved_steps = 0;  // steps whose motion could not be made collision free
   double work = 0;           // work units (collision/impact_zones.hpp) of the collision responses
   double largest_work = 0;   // ... of the costliest step
+  // The steps' warnings (ImpactZoneStats::warnings), the first kMaxWarnings of them; warnings counts them all.
+  static constexpr int kMaxWarnings = 10;
+  std::vector<std::string> first_warnings;
+  long long warnings = 0;
   void add(const ImpactZoneStats& s);
 };
 

@@ -1,7 +1,6 @@
 #include "collision/impact_zones.hpp"
 
 #include <algorithm>
-#include <iostream>
 #include <optional>
 #include <sstream>
 
@@ -327,10 +326,9 @@ void move_rigidly(const Zone& zone, const std::vector<Vec3>& target, ContactGeom
   for (int n : zone.nodes) g.x1[n] = g.x0[n] + displacement;
 }
 
-void warn(const ImpactZoneParams& params, const std::string& what) {
-  std::ostringstream msg;
-  msg << "warning: collision: step " << params.step << ": " << what << "\n";
-  std::cerr << msg.str();
+// WHY: recorded, not printed: the library has no console; the application shows them unless told to be quiet.
+void warn(const ImpactZoneParams& params, const std::string& what, ImpactZoneStats& stats) {
+  stats.warnings.push_back("collision: step " + std::to_string(params.step) + ": " + what);
 }
 
 }  // namespace
@@ -426,7 +424,7 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
       std::ostringstream what;
       what << "impact zone of " << dirty[k]->nodes.size() << " nodes is ill-conditioned (meeting its constraints "
            << "would move a node " << ill_ratio[k] << "x farther than its deepest violation); moving it rigidly";
-      warn(params, what.str());
+      warn(params, what.str(), stats);
     }
     mark_moved(dirty);
   }
@@ -443,7 +441,7 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
         std::ostringstream what;
         what << "impact zone of " << z.nodes.size() << " nodes unresolved after " << params.max_iterations
              << " iterations; moving it rigidly";
-        warn(params, what.str());
+        warn(params, what.str(), stats);
       } else if (z.state == ZoneState::kRigid && round > 0 && obstacle_displacement(z, g).norm() > 0) {
         // WHY: held at its start while an obstacle it touches moves on, the zone is run through: a sheet pressed
         // by a sphere was left behind inside it and later dragged up (conf/metal-crumple-remesh.json). Carried
@@ -452,14 +450,14 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
         std::ostringstream what;
         what << "rigid impact zone of " << z.nodes.size() << " nodes still collides; moving it with the "
              << "obstacle it touches";
-        warn(params, what.str());
+        warn(params, what.str(), stats);
       } else if ((z.state == ZoneState::kRigid && round > 0) || z.state == ZoneState::kCarried) {
         const bool carried = z.state == ZoneState::kCarried;
         z.state = ZoneState::kFrozen;
         std::ostringstream what;
         what << (carried ? "carried" : "rigid") << " impact zone of " << z.nodes.size()
              << " nodes still collides; holding it at its start position";
-        warn(params, what.str());
+        warn(params, what.str(), stats);
       }
       move_rigidly(z, target, g);
     }
@@ -474,7 +472,7 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
   std::ostringstream what;
   what << "collisions remain unresolved (zones held at their start positions are hit by moving obstacles "
        << "or other zones)";
-  warn(params, what.str());
+  warn(params, what.str(), stats);
   return finish(false);
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "collision/candidates.hpp"
@@ -73,6 +74,8 @@ struct ImpactZoneStats {
   // Nodes (geometry indices, sorted) of the zones on a fallback: their end positions are not the
   // physics' outcome, and the strain between them and their neighbours is not the material's.
   std::vector<int> fallback_nodes;
+  // What went wrong, one line each ("collision: step N: ..."): fallbacks, ill-conditioned zones, unresolved.
+  std::vector<std::string> warnings;
 };
 
 // Moves the movable nodes' end positions g.x1 so that the motion is collision free.
