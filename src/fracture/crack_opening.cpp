@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <array>
 
-#include "collision/triangle_intersection.hpp"
+#include "remesh/world_guard.hpp"
 
 namespace arcsim {
 namespace {
@@ -312,15 +312,15 @@ std::string lips_can_part(const EditSession& session, int node, const std::vecto
   around.erase(std::unique(around.begin(), around.end()), around.end());
   std::vector<int> splitting{node};
   splitting.insert(splitting.end(), split_far_ends.begin(), split_far_ends.end());
-  // Each face of `around` as it will be once the lips are set apart: its corners' positions and the nodes they
-  // will be (a split node's corner becomes the copy of its side: -1 - (its index in `splitting` * 8 + side)).
-  std::vector<std::array<Vec3, 3>> after(around.size());
-  std::vector<std::array<int, 3>> ids(around.size());
+  // Each face of `around` now and as it will be once the lips are set apart: its corners' positions and the nodes
+  // they will be (a split node's corner becomes the copy of its side, numbered below every real node and kNone).
+  std::vector<GuardTriangle> before(around.size());
   for (size_t i = 0; i < around.size(); ++i)
     for (int c = 0; c < 3; ++c) {
-      after[i][c] = m.nodes[m.face_node(around[i], c)].x;
-      ids[i][c] = m.face_node(around[i], c);
+      before[i].x[c] = m.nodes[m.face_node(around[i], c)].x;
+      before[i].nodes[c] = m.face_node(around[i], c);
     }
+  std::vector<GuardTriangle> after = before;
   for (size_t k = 0; k < splitting.size(); ++k) {
     const int n = splitting[k];
     const std::vector<int> all = m.node_faces(n);
@@ -336,8 +336,8 @@ std::string lips_can_part(const EditSession& session, int node, const std::vecto
       for (int f : own) {
         const size_t i = std::lower_bound(around.begin(), around.end(), f) - around.begin();
         const int c = m.corner_of_node(f, n);
-        after[i][c] += distance * d;
-        ids[i][c] = -1 - static_cast<int>(k * 8 + s);
+        after[i].x[c] += distance * d;
+        after[i].nodes[c] = kNone - 1 - static_cast<int>(k * 8 + s);
       }
     }
   }
@@ -345,26 +345,9 @@ std::string lips_can_part(const EditSession& session, int node, const std::vecto
   // moves that part each twin pair well can still leave the new lips crossing: where the crack reaches a
   // border, the lip directions of the two ends can run mostly along the crack edge, in opposite senses, and the
   // two lips' edges then cross in an X (f15 static ornament, step 4: 20 um apart along the edge, one lip over
-  // the other's face 0.1 um out of the surface), which no contact normal can part. So the faces around the
-  // split, moved as the lips will be, must not meet unless they still share a node after the split (nor, for
-  // faces that shared none before, meet where they did not meet before).
-  auto shares = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
-    for (int x : a)
-      if (std::find(b.begin(), b.end(), x) != b.end()) return true;
-    return false;
-  };
-  for (size_t i = 0; i < around.size(); ++i)
-    for (size_t j = i + 1; j < around.size(); ++j) {
-      if (shares(ids[i], ids[j]) || !triangles_intersect(after[i], after[j])) continue;
-      std::array<int, 3> ni, nj;
-      std::array<Vec3, 3> xi, xj;
-      for (int c = 0; c < 3; ++c) {
-        ni[c] = m.face_node(around[i], c), nj[c] = m.face_node(around[j], c);
-        xi[c] = m.nodes[ni[c]].x, xj[c] = m.nodes[nj[c]].x;
-      }
-      if (!shares(ni, nj) && triangles_intersect(xi, xj)) continue;  // crossing before: not the opening's
-      return "the lips would cross once set apart (faces of the split meet where they share no node)";
-    }
+  // the other's face 0.1 um out of the surface), which no contact normal can part.
+  if (edit_makes_crossing(before, after))
+    return "the lips would cross once set apart (faces of the split meet where they share no node)";
   return "";
 }
 

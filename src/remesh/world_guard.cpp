@@ -293,6 +293,23 @@ bool WorldGuard::folds_through_neighbours(const std::vector<GuardTriangle>& tria
   return false;
 }
 
+bool edit_makes_crossing(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after) {
+  auto share_a_node = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
+    for (int x : a)
+      if (x != kNone && std::find(b.begin(), b.end(), x) != b.end()) return true;
+    return false;
+  };
+  const size_t n = std::min(before.size(), after.size());
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      if (share_a_node(after[i].nodes, after[j].nodes) || !triangles_intersect(after[i].x, after[j].x)) continue;
+      const bool crossed_before =
+          !share_a_node(before[i].nodes, before[j].nodes) && triangles_intersect(before[i].x, before[j].x);
+      if (!crossed_before) return true;
+    }
+  return false;
+}
+
 bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
                         const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
   std::vector<int> sorted = replaced;

@@ -249,10 +249,6 @@ CollisionSettings Simulation::collision_settings() const {
   // keeps the full thickness between all parts of a sheet, as ARCSim has it (its frames stay as they were).
   s.neighbour_thickness = scene_.enabled("fracture") ? fracture.opening.lip_gap : s.repulsion_thickness;
   s.step = step_;
-  // At the finest substep a fallback can no longer be substepped away, and stacked crack lips keep the side
-  // they start on (at coarser levels their fallback made the step substep, which bounds the collision
-  // correction: docs/stability.md, 2026-12-06 (h2)).
-  s.stacked_lips_keep_start_side = finest_substep_;
   s.work_budget = scene_.collision_budget * static_cast<double>(cloth_node_count(cloths));
   // Floor proxy: the plane y = lowest point of the (active) floor obstacles.
   for (const Obstacle& o : obstacles) {
@@ -282,10 +278,14 @@ std::vector<std::vector<ContactTerm>> Simulation::proximity_step(double dt) {
   return collisions_.proximity_terms(cloth_meshes, active_obstacle_meshes(obstacles), collision_settings(), dt);
 }
 
-void Simulation::collision_step(double dt) {
+void Simulation::collision_step(double dt, bool finest_substep) {
   std::vector<Mesh*> cloth_meshes;
   for (Cloth& c : cloths) cloth_meshes.push_back(&c.mesh);
-  const CollisionSettings settings = collision_settings();
+  CollisionSettings settings = collision_settings();
+  // At the finest substep a fallback can no longer be substepped away, and stacked crack lips keep the side
+  // they start on (at coarser levels their fallback made the step substep, which bounds the collision
+  // correction: docs/stability.md, 2026-12-06 (h2)).
+  settings.stacked_lips_keep_start_side = finest_substep;
   const ImpactZoneStats stats =
       collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), settings, dt);
   step_fallback_nodes_ = collisions_.fallback_nodes();
@@ -384,7 +384,7 @@ void Simulation::advance_step() {
   audit(&StepEnergies::after_remeshing, true);
 }
 
-void Simulation::dynamics_step(double dt) {
+void Simulation::dynamics_step(double dt, bool finest_substep) {
   auto t0 = std::chrono::steady_clock::now();
   step_contacts_.clear();
   step_fallback_nodes_.clear();
@@ -411,7 +411,7 @@ void Simulation::dynamics_step(double dt) {
       for (const Node& n : cloth.mesh.nodes) after_physics.back().push_back(n.x);
     }
   t0 = std::chrono::steady_clock::now();
-  if (scene_.enabled("collision")) collision_step(dt);
+  if (scene_.enabled("collision")) collision_step(dt, finest_substep);
   times.collision += seconds_since(t0);
   step_correction_ = 0;
   step_correction_at_ = {-1, -1};
@@ -491,7 +491,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
   for (;;) {
     const int substeps = 1 << substep_level_;
     const double h = dt / substeps;
-    finest_substep_ = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
+    const bool finest = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
     std::string problem;
     std::vector<std::vector<int>> fallback_nodes(cloths.size());
     try {
@@ -500,7 +500,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
       for (int k = 0; k < substeps && problem.empty(); ++k) {
         time_ = k + 1 == substeps ? start + dt : start + (k + 1) * h;
         move_obstacles(time_);
-        dynamics_step(h);
+        dynamics_step(h, finest);
         problem = substep_problem(h);
         for (size_t c = 0; c < step_fallback_nodes_.size() && c < cloths.size(); ++c)
           fallback_nodes[c].insert(fallback_nodes[c].end(), step_fallback_nodes_[c].begin(),
@@ -520,19 +520,17 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
         --substep_level_;
         steps_at_level_ = 0;
       }
-      finest_substep_ = false;
       return h;
     }
     restore_snapshot(snapshot, cloths);
     time_ = start + dt;
     ++time_step_stats.retries;
     time_step_stats.cause = problem;
-    if (!(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel) {
+    if (finest) {
       std::ostringstream what;
       what << "step " << step_ << " (t = " << start << " to " << start + dt << " s) failed at the smallest substep "
            << h << " s (adaptive_time_step.min_step " << a.min_step << " s): " << problem
            << "; try a smaller min_step or time step";
-      finest_substep_ = false;
       throw NumericalError(what.str());
     }
     ++substep_level_;

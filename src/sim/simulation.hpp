@@ -193,9 +193,11 @@ class Simulation {
   std::vector<std::vector<ContactTerm>> proximity_step(double dt);
   // The implicit step of every cloth with its loads and step_contacts_.
   void physics_step(double dt);
-  void collision_step(double dt);
+  // The collision response over dt; finest_substep: the adaptive step's finest substep (no finer one left to
+  // retry with).
+  void collision_step(double dt, bool finest_substep);
   // Proximity, the implicit step and the collision response over dt, ending at time_ (obstacles already moved).
-  void dynamics_step(double dt);
+  void dynamics_step(double dt, bool finest_substep = false);
   // The dynamics of the step [start, start + dt] with adaptive time stepping: as 2^level substeps, redone from
   // the step's start one level finer whenever a substep fails (NumericalError, substep_problem). Returns the
   // last substep's size. Throws NumericalError when the step fails at min_step.
@@ -234,8 +236,6 @@ class Simulation {
   // their strain; FractureContext::untrusted_nodes).
   std::vector<std::vector<int>> step_fallback_nodes_;
   int substep_level_ = 0;
-  // True while the adaptive step runs its finest substep (no finer one left to retry with).
-  bool finest_substep_ = false;
   int steps_at_level_ = 0;
   // With adaptive_time_step: how far the last dynamics step's collision response moved a cloth node (m), and
   // which (cloth, node).

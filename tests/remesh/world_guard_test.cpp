@@ -125,5 +125,35 @@ TEST(WorldGuard, AllowsEditsThatComeNoCloserThanBefore) {
   EXPECT_TRUE(guard.allows({low}, {high}, {GuardSweep{{low.x[0], high.x[0], low.x[1], low.x[2]}, {}}}, {}));
 }
 
+// An edit that splits a node (a crack opening) may not leave two of its own faces crossing: faces that shared
+// the node before and share none after must not meet after, unless they already crossed before.
+TEST(EditMakesCrossing, FacesThatASplitSeparatesMustNotMeet) {
+  const GuardTriangle a{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, {0, 1, 2}};
+  // b shares node 0 with a; its other corners lie either side of a's plane, over a's interior.
+  const GuardTriangle b{{Vec3(0, 0, 0), Vec3(0.2, 0.2, 0.5), Vec3(-1, -1, 0)}, {0, 3, 4}};
+  GuardTriangle b_moved = b;  // node 0 split: b's copy (a new id) moved under a, its edge to node 3 piercing a
+  b_moved.x[0] = Vec3(0.2, 0.2, -0.5);
+  b_moved.nodes[0] = -2;
+  ASSERT_TRUE(triangles_intersect(a.x, b_moved.x));
+  EXPECT_TRUE(edit_makes_crossing({a, b}, {a, b_moved}));
+  // The same positions with node 0 still shared: neighbours are not compared (they meet at their node).
+  GuardTriangle b_same_node = b_moved;
+  b_same_node.nodes[0] = 0;
+  EXPECT_FALSE(edit_makes_crossing({a, b}, {a, b_same_node}));
+  // Crossing already before, sharing no node then: not the edit's doing.
+  GuardTriangle b_apart = b_moved;
+  b_apart.nodes[0] = 5;
+  EXPECT_FALSE(edit_makes_crossing({a, b_apart}, {a, b_moved}));
+  // The copy moved away from a instead: nothing meets.
+  GuardTriangle b_away = b_moved;
+  b_away.x[0] = Vec3(-0.2, -0.2, 0);
+  EXPECT_FALSE(edit_makes_crossing({a, b}, {a, b_away}));
+  // kNone corners (not in the mesh) never count as shared.
+  GuardTriangle a_unknown = a, b_unknown = b_moved;
+  a_unknown.nodes = {kNone, kNone, kNone};
+  b_unknown.nodes = {kNone, kNone, kNone};
+  EXPECT_TRUE(edit_makes_crossing({a, b}, {a_unknown, b_unknown}));
+}
+
 }  // namespace
 }  // namespace arcsim
