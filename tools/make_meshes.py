@@ -11,9 +11,10 @@ meshes/square_notch.obj the square with a 90-degree V notch (0.1 m deep, 0.2 m w
 meshes/square_slit.obj  1 m x 1 m, 20 x 20 cells, a slit 0.2 deep into the middle of the left side (a thin V, 0.02
                         wide at the edge, tip at (0.2, 0.5)); 445 nodes, 800 faces; bottom side label 1, top side
                         label 2 (rubber tearing, conf/paper-rubber-tear.json).
-meshes/square_top_slit.obj  the same turned a quarter turn: the slit runs down from the middle of the top side
-                        (tip at (0.5, 0.8)); grips along the top two rows left (x in [0.25, 0.4], label 1) and
-                        right (x in [0.6, 0.75], label 2) of it (paper tearing, conf/paper-tearing.json).
+meshes/square_top_notch.obj  1 m x 1 m, 20 x 20 cells, a V notch 0.05 deep (0.01 wide at the edge) cut down
+                        from the middle of the top side, tip at (0.5, 0.95); 442 nodes, 800 faces; four 3 x 3-node
+                        corner grips centred 0.1 in from the corners, left label 1, right label 2 (paper tearing,
+                        conf/paper-tearing.json).
 meshes/square_clamped.obj  the square (10 x 10 cells, 121 nodes, 200 faces) with its 40 border nodes labelled 1
                         (clamped all round: conf/paper-variety.json).
 meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle, scaled up by the scenes.
@@ -158,19 +159,21 @@ def square_slit():
     return nodes, faces, labels
 
 
-def square_top_slit():
-    """meshes/square_top_slit.obj: the slit sheet turned a quarter turn clockwise, so the slit (0.2 deep, 0.02
-    wide at the edge) runs down from the middle of the top side, tip at (0.5, 0.8). Label 1: the nodes of the
-    top two rows with x in [0.25, 0.4] (a grip left of the slit), label 2: x in [0.6, 0.75] (a grip right of it);
-    paper tearing by hand."""
-    nodes, faces, node, _ = slit_sheet(20, 4, 0.01)
+def square_top_notch():
+    """meshes/square_top_notch.obj: 20 x 20 cells with a small V notch (one cell, 0.05 deep, 0.01 wide at the edge)
+    cut down from the middle of the top side, tip at (0.5, 0.95): the slit sheet of square_slit with a one-cell
+    slit, turned a quarter turn clockwise. The hands hold the sheet at four 0.1 x 0.1 corner patches (3 x 3 nodes)
+    centred 0.1 in from each corner: label 1 the two on the left (x = 0.1), label 2 the two on the right
+    (x = 0.9); turning the hands apart in the sheet's plane opens the notch (paper tearing by hand)."""
+    nodes, faces, node, _ = slit_sheet(20, 1, 0.005)
     nodes = [(y, 1 - x) for x, y in nodes]   # rotation by -90 degrees plus a shift: keeps the faces CCW
     labels = {}
     for n, (x, y) in enumerate(nodes):
-        if y > 0.899:
-            if 0.249 < x < 0.401:
+        near = lambda a, b: abs(a - b) < 0.051
+        if near(y, 0.1) or near(y, 0.9):
+            if near(x, 0.1):
                 labels[n] = 1
-            elif 0.599 < x < 0.751:
+            elif near(x, 0.9):
                 labels[n] = 2
     return nodes, faces, labels
 
@@ -428,9 +431,9 @@ def main():
     write_obj(os.path.join(out_dir, "square_slit.obj"),
               "1 m x 1 m sheet, 20 x 20 cells, with a slit 0.2 deep (tip at 0.2 0.5) into its left side; bottom "
               "label 1, top label 2\n" + generated, *square_slit())
-    write_obj(os.path.join(out_dir, "square_top_slit.obj"),
-              "1 m x 1 m sheet, 20 x 20 cells, with a slit 0.2 deep (tip at 0.5 0.8) down from its top side; grips "
-              "left (label 1) and right (label 2) of it along the top\n" + generated, *square_top_slit())
+    write_obj(os.path.join(out_dir, "square_top_notch.obj"),
+              "1 m x 1 m sheet, 20 x 20 cells, with a V notch 0.05 deep (tip at 0.5 0.95) in its top side; corner "
+              "grips left (label 1) and right (label 2)\n" + generated, *square_top_notch())
     write_obj(os.path.join(out_dir, "square_clamped.obj"),
               "1 m x 1 m flat sheet, 10 x 10 cells; every border node label 1\n" + generated, *square_clamped())
     write_obj(os.path.join(out_dir, "ground.obj"),
