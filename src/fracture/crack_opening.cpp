@@ -321,12 +321,10 @@ std::string lips_can_part(const EditSession& session, int node, const std::vecto
       before[i].nodes[c] = m.face_node(around[i], c);
     }
   std::vector<GuardTriangle> after = before;
-  for (size_t k = 0; k < splitting.size(); ++k) {
-    const int n = splitting[k];
+  int next_copy = kNone - 1;  // ids of the split nodes' copies, one per side, counted down from below kNone
+  for (const int n : splitting) {
     const std::vector<int> all = m.node_faces(n);
-    const std::vector<std::vector<int>> sides = sides_of(m, n, crack_edges);
-    for (size_t s = 0; s < sides.size(); ++s) {
-      const std::vector<int>& own = sides[s];
+    for (const std::vector<int>& own : sides_of(m, n, crack_edges)) {
       const Vec3 d = lip_direction(m, own, all);
       if (!(d.norm() > 0)) return guard_refuses;
       NodeMoveOptions options;
@@ -337,8 +335,9 @@ std::string lips_can_part(const EditSession& session, int node, const std::vecto
         const size_t i = std::lower_bound(around.begin(), around.end(), f) - around.begin();
         const int c = m.corner_of_node(f, n);
         after[i].x[c] += distance * d;
-        after[i].nodes[c] = kNone - 1 - static_cast<int>(k * 8 + s);
+        after[i].nodes[c] = next_copy;
       }
+      --next_copy;
     }
   }
   // The guard does not check the lips against each other (they touch at the split nodes until the split), and
