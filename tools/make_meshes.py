@@ -21,7 +21,7 @@ meshes/ground.obj       1 m x 1 m, one cell (2 faces, 4 nodes): a floor obstacle
 meshes/sphere.obj       unit sphere (radius 1 m, centre 0) as an icosahedron subdivided twice: 162 nodes,
                         320 faces, outward (CCW seen from outside). An obstacle, scaled by the scenes.
 meshes/geosphereF.obj   unit geodesic sphere (icosahedron faces cut F x F), 20 F^2 faces, F in
-                        ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 16, 20: static meshes to
+                        ORNAMENT_FREQUENCIES (6: the adaptive ornament's start; 12, 14, 15, 16, 20: static meshes to
                         match an adaptive run's mean face count, conf/paper-ornament*.json).
 meshes/hemisphere.obj   unit hemisphere z >= 0 (octahedron's upper faces cut 8 x 8), 256 faces; rim label 1
                         (conf/paper-dome.json).
@@ -334,7 +334,7 @@ def write_obj_general(path, comment, nodes, faces, labels=None, materials=None, 
 
 # Frequencies of the geodesic ornament meshes written by main(): 6 is the adaptive run's coarse start; the
 # others are static meshes of 20 f^2 faces to match an adaptive run's mean face count (conf/paper-ornament*.json).
-ORNAMENT_FREQUENCIES = (6, 12, 14, 16, 20)
+ORNAMENT_FREQUENCIES = (6, 12, 14, 15, 16, 20)
 def periodic_tube(cells_around, cells_up, height, place):
     """A tube: a grid `cells_around` x `cells_up` whose last column is glued to the first. `place(s, z)` maps
     the unrolled coordinate s in [0, 1) and the height z to a 3D point. Diagonals alternate like a chequerboard
