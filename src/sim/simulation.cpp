@@ -290,10 +290,8 @@ void Simulation::collision_step(double dt, bool finest_substep) {
       collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), settings, dt);
   step_fallback_nodes_ = collisions_.fallback_nodes();
   if (!stats.out_of_budget) return;
-  // The cause alone under adaptive time stepping, which redoes the step in substeps and names the step if
-  // even its smallest substep fails.
+  // The cause; the step names itself (Simulation::step, or the adaptive step if even its smallest substep fails).
   std::ostringstream msg;
-  if (!scene_.adaptive_step.enabled) msg << "step " << step_ << " (t = " << time_ - dt << " to " << time_ << " s): ";
   msg << "collision handling did not converge within its budget (" << stats.work << " work units; collision_budget "
       << scene_.collision_budget << " per node x " << cloth_node_count(cloths) << " nodes): " << stats.zones
       << " impact zones, the largest " << stats.largest_zone << " nodes";
@@ -360,7 +358,14 @@ void Simulation::advance_step() {
     dynamics_dt = adaptive_dynamics_step(start, dt);
   } else {
     move_obstacles(time_);
-    dynamics_step(dt);
+    try {
+      dynamics_step(dt);
+    } catch (const NumericalError& e) {
+      // Named here, once, for every cause (the adaptive step names it when its smallest substep fails).
+      std::ostringstream what;
+      what << "step " << step_ << " (t = " << start << " to " << time_ << " s): " << e.what();
+      throw NumericalError(what.str());
+    }
     time_step_stats.record(1, dt, 0);
   }
 

@@ -192,19 +192,20 @@ TEST(StressGlassSlowCheck, PlateShatteringAtFiveMillisecondStepsEndsWithAdaptive
 }
 
 
-// "A sheet torn into hundreds of pieces": the plate dropped 3 cm with 5 ms steps as above, at 3e6 Pa (0.15 of
-// its toughness), fixed steps, to 0.12 s (docs/repro/glass-plate-shards.json with "toughness": 3e6 and
-// "max_cracks": 2000). It shatters on landing into about 280 pieces, many of a few faces, lying pressed against
-// each other on the floor. What holds: every frame valid, finite, above the floor, free of crossing triangles.
-// (Written at 5e6 Pa, which gave 156 pieces; since the facing-lip normals of 2026-12-05 it gives 88, no longer
-// the case's "hundreds". At 4e6 Pa the plate breaks into 284 pieces and frame 24 holds one crossing pair, and at
-// 1e7 Pa step 22 exhausts the collision budget: docs/stability.md, 2026-12-06.)
+// "A sheet torn into hundreds of pieces": the plate dropped 3 cm with 5 ms steps as above, at 1.5e6 Pa (0.075 of
+// its toughness), fixed steps, to 0.12 s (docs/repro/glass-plate-shards.json with "toughness": 1.5e6 and
+// "max_cracks": 2000). It shatters on landing into hundreds of pieces, many of a few faces, lying pressed against
+// each other on the floor. What holds: every frame valid, finite, above the floor, free of crossing triangles;
+// the run either ends or stops as issue 14 allows (a NumericalError naming its step), after the shattering.
+// WHY 1.5e6 Pa: near the threshold the outcome is chaotic and machine-dependent (OpenBLAS picks other kernels
+// on other CPUs, so rounding differs): at 3e6 Pa the plate gave 280 pieces on the AMD guest and 2 on the Intel
+// one; at 1.5e6-2e6 Pa it gives 431-512 there, and 1e6 Pa 598 (docs/stability.md, 2026-12-06 afternoon).
 TEST(StressShardsSlowCheck, PlateShatteredIntoAHundredPiecesStaysValidAndIntersectionFree) {
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
   TempDir dir;
   std::string scene = dropped_plate_scene(root, "5e-3", "0.12", "");
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{R"("toughness": 2e7)", R"("toughness": 3e6)"},
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{R"("toughness": 2e7)", R"("toughness": 1.5e6)"},
                                  {R"("max_cracks": 400)", R"("max_cracks": 2000)"}})
     scene.replace(scene.find(from), from.size(), to);
   Simulation sim = load_scene_text(dir, scene);
@@ -223,8 +224,12 @@ TEST(StressShardsSlowCheck, PlateShatteredIntoAHundredPiecesStaysValidAndInterse
   } catch (const NumericalError& e) {
     failure = e.what();
   }
-  std::printf("[ result ] shards: up to %d pieces, %d crossing pairs over the frames\n", most_pieces, crossing);
-  EXPECT_EQ(failure, "");
+  std::printf("[ result ] shards: up to %d pieces, %d crossing pairs over the frames; %s\n", most_pieces, crossing,
+              failure.empty() ? "ran to its end" : ("stopped: " + failure).c_str());
+  if (!failure.empty()) {
+    EXPECT_EQ(failure.rfind("step ", 0), 0u) << "a stop must name its step: " << failure;
+    EXPECT_GT(most_pieces, 100) << "stopped before it shattered: " << failure;
+  }
   EXPECT_EQ(invalid, "");
   EXPECT_GE(lowest, -1e-4) << "a node went through the floor";
   EXPECT_EQ(crossing, 0);
