@@ -74,6 +74,16 @@ void copy_module_times(const ModuleTimes& times, FrameWallTimes& wall) {
   wall.fracture = times.fracture;
 }
 
+// The frame's collision warnings (the first few, and how many more), each on its own line.
+void print_collision_warnings(const ImpactZoneTotals& totals, Progress& progress, const Console& console) {
+  if (totals.warnings == 0) return;
+  progress.end_line();
+  for (const std::string& w : totals.first_warnings) console.warn(w);
+  const long long more = totals.warnings - static_cast<long long>(totals.first_warnings.size());
+  if (more > 0) console.warn("collision: " + std::to_string(more) + " more warnings in this frame (log.jsonl: "
+                             "impact_zones.warnings counts them)");
+}
+
 }  // namespace
 
 SimulateOptions parse_simulate_options(const std::vector<std::string>& args) {
@@ -168,16 +178,6 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   report.factorizations = sim.times.solver.factorizations;
   report.solver_iterations = sim.times.solver.iterations;
   report.residuals = sim.times.solver.residuals;
-}
-
-// The frame's collision warnings (the first few, and how many more), each on its own line.
-static void print_collision_warnings(const ImpactZoneTotals& totals, Progress& progress, const Console& console) {
-  if (totals.warnings == 0) return;
-  progress.end_line();
-  for (const std::string& w : totals.first_warnings) console.warn(w);
-  const long long more = totals.warnings - static_cast<long long>(totals.first_warnings.size());
-  if (more > 0) console.warn("collision: " + std::to_string(more) + " more warnings in this frame (log.jsonl: "
-                             "impact_zones.warnings counts them)");
 }
 
 void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& options, const Console& console) {

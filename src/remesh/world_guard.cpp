@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "collision/distance.hpp"
 #include "collision/triangle_intersection.hpp"
@@ -299,7 +301,10 @@ bool edit_makes_crossing(const std::vector<GuardTriangle>& before, const std::ve
       if (x != kNone && std::find(b.begin(), b.end(), x) != b.end()) return true;
     return false;
   };
-  const size_t n = std::min(before.size(), after.size());
+  if (before.size() != after.size())
+    throw std::invalid_argument("edit_makes_crossing: " + std::to_string(before.size()) + " triangles before but " +
+                                std::to_string(after.size()) + " after (they must be the same faces, index for index)");
+  const size_t n = before.size();
   for (size_t i = 0; i < n; ++i)
     for (size_t j = i + 1; j < n; ++j) {
       if (share_a_node(after[i].nodes, after[j].nodes) || !triangles_intersect(after[i].x, after[j].x)) continue;

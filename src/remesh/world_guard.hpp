@@ -36,9 +36,10 @@ struct GuardSweep {
 // Whether an edit that turns the triangles `before` into `after` (the same faces, index for index: corners moved,
 // and node ids renamed as the edit renames them, e.g. a split node's copies given new ids) makes two of them
 // cross: a pair that shares no node after the edit meets after it, and did not meet, sharing no node, before.
-// kNone never counts as shared. WHY: WorldGuard checks an edit's triangles against the rest of the surface, not
-// against each other; an edit that separates faces (a crack opening splits a node) can leave two of its own
-// faces crossing (docs/stability.md, 2026-12-06 (h4)), which no contact normal can part afterwards.
+// kNone never counts as shared. Throws std::invalid_argument if `before` and `after` differ in size (a caller's
+// mistake: they must be the same faces). WHY: WorldGuard checks an edit's triangles against the rest of the
+// surface, not against each other; an edit that separates faces (a crack opening splits a node) can leave two of
+// its own faces crossing (docs/stability.md, 2026-12-06 (h4)), which no contact normal can part afterwards.
 bool edit_makes_crossing(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after);
 
 class WorldGuard {

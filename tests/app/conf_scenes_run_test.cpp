@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "app/app_test_support.hpp"
+#include "io/obj.hpp"
+#include "mesh/pieces.hpp"
 
 namespace arcsim::app_test {
 namespace {
@@ -188,15 +190,27 @@ TEST(ConfScenes, SlowCheckPaperTearingTearsThroughIntoTwoHalves) {
   EXPECT_EQ(pieces[0], 2) << "two halves, no shards";
   const auto [largest, faces] = largest_piece_and_faces(run.last.out);
   EXPECT_LE(largest, 6 * faces / 10) << "the tear runs down the middle";
-  // Torn through: the two halves' nearest nodes are centimetres apart at the end (the hands pulled 12 cm).
-  const std::vector<std::array<double, 3>> end = obj_vertices(run.dir + "/00500_00.obj");
-  ASSERT_FALSE(end.empty());
-  double left = -1, right = 1;  // the innermost x of the left and right halves, split at the sheet's middle
-  for (const auto& [x, y, z] : end) {
-    if (x < 0) left = std::max(left, x);
-    else right = std::min(right, x);
+  // Torn through: the two halves' nearest nodes are centimetres apart at the end (the hands pulled 12 cm). The
+  // halves are the last frame's pieces as its faces join them (wherever the tear ran), and the gap is the
+  // smallest distance between a node of one and a node of the other: 8.53 cm measured (one thread, 2 cm asked).
+  const Mesh end = load_obj_mesh(run.dir + "/00500_00.obj");
+  ASSERT_EQ(mesh_pieces(end).size(), 2u);
+  std::array<std::vector<Vec3>, 2> halves;
+  std::vector<char> seen(end.nodes.size(), 0);
+  const std::vector<int> piece_of_face = face_pieces(end);
+  for (int f = 0; f < static_cast<int>(end.faces.size()); ++f) {
+    if (piece_of_face[f] < 0) continue;  // a dead face (none in a loaded frame)
+    for (int c = 0; c < 3; ++c) {
+      const int n = end.face_node(f, c);
+      if (!seen[n]) halves[piece_of_face[f]].push_back(end.nodes[n].x);
+      seen[n] = 1;
+    }
   }
-  EXPECT_GT(right - left, 0.02) << "the halves are apart";
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Vec3& a : halves[0])
+    for (const Vec3& b : halves[1]) gap = std::min(gap, (a - b).norm());
+  std::printf("[ measure ] paper-tearing: the halves are %.4f m apart at the end\n", gap);
+  EXPECT_GT(gap, 0.02) << "the halves are apart";
 }
 
 }  // namespace

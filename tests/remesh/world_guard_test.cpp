@@ -5,6 +5,8 @@
 // without it the same pass crosses it or leaves it outside (so the test can tell).
 #include <gtest/gtest.h>
 
+#include <stdexcept>
+
 #include "collision/triangle_intersection.hpp"
 #include "mesh/validate.hpp"
 #include "remesh/remesh.hpp"
@@ -153,6 +155,17 @@ TEST(EditMakesCrossing, FacesThatASplitSeparatesMustNotMeet) {
   a_unknown.nodes = {kNone, kNone, kNone};
   b_unknown.nodes = {kNone, kNone, kNone};
   EXPECT_TRUE(edit_makes_crossing({a, b}, {a_unknown, b_unknown}));
+}
+
+// before and after are the same faces, index for index: lists of different sizes are a caller's mistake, not
+// an edit to judge on the faces they have in common.
+TEST(EditMakesCrossing, ThrowsIfBeforeAndAfterDifferInSize) {
+  const GuardTriangle a{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, {0, 1, 2}};
+  const GuardTriangle b{{Vec3(0, 0, 0), Vec3(0.2, 0.2, 0.5), Vec3(-1, -1, 0)}, {0, 3, 4}};
+  EXPECT_THROW(edit_makes_crossing({a, b}, {a}), std::invalid_argument);
+  EXPECT_THROW(edit_makes_crossing({a}, {a, b}), std::invalid_argument);
+  EXPECT_THROW(edit_makes_crossing({}, {a}), std::invalid_argument);
+  EXPECT_NO_THROW(edit_makes_crossing({}, {}));
 }
 
 }  // namespace
