@@ -493,6 +493,7 @@ class SceneParser {
     }
     ObjectReader r(*f.value, f.at, scene_.warnings);
     m.fixed_high_res_mesh = get_bool(r.get("fixed_high_res_mesh"), m.fixed_high_res_mesh);
+    m.remesh_at_start = get_bool(r.get("remesh_at_start"), m.remesh_at_start);
     m.handle_stiffness = get_real(r.get("handle_stiffness"), m.handle_stiffness, kNonNegative);
     m.collision_stiffness = get_real(r.get("collision_stiffness"), m.collision_stiffness, kNonNegative);
     m.repulsion_thickness = get_real(r.get("repulsion_thickness"), m.repulsion_thickness, kPositive);

@@ -73,6 +73,9 @@ struct WindSpec {
 
 struct MagicParams {
   bool fixed_high_res_mesh = false;
+  // Ours: remesh every cloth once at start-up, before the first step, as ARCSim's initial relaxation does
+  // (false: the first remesh comes at the end of frame 1, on the mesh the input file gave).
+  bool remesh_at_start = true;
   double handle_stiffness = 1e3;       // N/m
   double collision_stiffness = 1e9;    // N/m^3 (times element area)
   double repulsion_thickness = 1e-3;   // m

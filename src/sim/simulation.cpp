@@ -74,6 +74,11 @@ Simulation::Simulation(const Scene& scene) : scene_(scene), motions_(scene.motio
   move_obstacles(0);
   for (Obstacle& o : obstacles)
     for (Node& n : o.mesh.nodes) n.v.setZero();
+  // ARCSim's start-up remeshes every cloth once before the first step (relax_initial_state's remeshing step,
+  // without a pop filter), so frame 0 is already sized for the sheet at rest. WHY: stepping first on the input
+  // mesh (square.json: 4 faces) folds it along its few edges, and the first remesh then refines those folds to
+  // size_min (1024 faces) only to coarsen them again a frame later.
+  if (scene_.magic.remesh_at_start) remeshing_step();
 }
 
 void Simulation::load_cloth(const ClothSpec& spec, int index) {

@@ -293,7 +293,7 @@ TEST(Simulate, NumericalBlowUpExitsThreeAndKeepsEarlierFrames) {
   EXPECT_EQ(lines_of(read_text(out + "/log.jsonl")).size(), 6u);
 }
 
-// A full disk during a run (a 300 KiB tmpfs, mounted if this test runs as root where mounting is allowed): the
+// A full disk during a run (a 2 MiB tmpfs: frames of ~0.3 MB from frame 0 on, mounted if this test runs as root where mounting is allowed): the
 // run stops with one clear line naming the file and "No space left on device", exit 2 or 3, and every frame
 // with a state file is complete (byte-identical to the same frame of a run with room), with no temporary file
 // left behind.
@@ -303,7 +303,7 @@ TEST(Simulate, FullDiskStopsWithAClearErrorAndKeepsCompleteFrames) {
   const std::string disk = tmp / "disk";
   fs::create_directories(disk);
   if (::geteuid() != 0 ||
-      std::system(("mount -t tmpfs -o size=300k tmpfs " + shell_quote(disk) + " 2>/dev/null").c_str()) != 0)
+      std::system(("mount -t tmpfs -o size=2m tmpfs " + shell_quote(disk) + " 2>/dev/null").c_str()) != 0)
     GTEST_SKIP() << "cannot mount a small tmpfs here (needs root and mount permission)";
   struct Unmount {
     std::string path;

@@ -4,6 +4,8 @@
 // per frame. Skipped where the ARCSim example folder is absent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -170,6 +172,43 @@ TEST(ArcsimRemeshPop, SlowSquarePopDoesNotPop) {
               worst, 100 * worst / typical);
   EXPECT_GT(typical, 0);
   EXPECT_LT(worst, 0.1 * typical);
+}
+
+// ARCSim remeshes every cloth once at start-up (relax_initial_state), so its frame 0 of square.json holds 128
+// faces (its 00000.bin), not the input's 4. Ours does the same (magic.remesh_at_start): the sheet at rest is
+// sized before the first step, so no step folds the 4-face input along its diagonals (which the first frame's
+// remesh then refined to 1024 faces and the next coarsened back to ~220). The sheet stays nearly flat and at
+// rest, and the handled corners keep their nodes.
+TEST(ArcsimRemeshStartUp, SquareIsSizedAtRestBeforeTheFirstStep) {
+  const std::string path = scene_path("square");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "ARCSim example scenes not found at " << path;
+  Scene scene = load_scene(path);
+  const Simulation sim(scene);
+  const Mesh& m = sim.cloths[0].mesh;
+  EXPECT_EQ(check_mesh(m), "");
+  EXPECT_EQ(mesh_size_stats(m).faces, 128);  // ARCSim 0.3.1's frame 0, measured
+  // Nearly flat: the reprojection places new nodes at their local equilibrium under gravity, up to 1.1 mm
+  // below the input's plane z = 0 (measured), while the input's own nodes stay in it.
+  for (const Node& n : m.nodes) {
+    EXPECT_LE(n.x.z(), 0.0);
+    EXPECT_GT(n.x.z(), -2e-3);
+    EXPECT_EQ(n.v, Vec3::Zero());
+  }
+  ASSERT_EQ(sim.handles.size(), 2u);
+  for (const Handle& h : sim.handles) {
+    ASSERT_EQ(h.nodes.size(), 2u);
+    for (size_t k = 0; k < h.nodes.size(); ++k) {
+      ASSERT_GE(h.nodes[k], 0);
+      ASSERT_LT(h.nodes[k], static_cast<int>(m.nodes.size()));
+      EXPECT_EQ(m.nodes[h.nodes[k]].x, h.anchors[k]);
+      EXPECT_NEAR(std::abs(h.anchors[k].x()), 0.5, 1e-12);
+      EXPECT_NEAR(std::abs(h.anchors[k].y()), 0.5, 1e-12);
+    }
+  }
+  // Switched off, the first step sees the input mesh.
+  scene.magic.remesh_at_start = false;
+  const Simulation unsized(scene);
+  EXPECT_EQ(mesh_size_stats(unsized.cloths[0].mesh).faces, 4);
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 // when the shared ARCSim scenes are absent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -32,7 +35,10 @@ Simulation load(const std::string& name) { return Simulation(load_scene((arcsim_
 
 TEST(SimulationReference, SphereBreakPutsRestAndWorldShapesOnTheFittedSphere) {
   REQUIRE_ARCSIM_SCENES();
-  const Simulation sim = load("sphere-break.json");
+  // The loaded input, before the start-up remesh (tested below) changes its triangles.
+  Scene scene = load_scene((arcsim_scenes() / "conf" / "sphere-break.json").string());
+  scene.magic.remesh_at_start = false;
+  const Simulation sim(scene);
   const Cloth& cloth = sim.cloths[0];
   ASSERT_TRUE(cloth.reference);
   EXPECT_EQ(cloth.reference->kind(), "sphere");
@@ -54,6 +60,31 @@ TEST(SimulationReference, SphereBreakPutsRestAndWorldShapesOnTheFittedSphere) {
     EXPECT_NEAR(mesh.edges[e].rest_theta, mesh.rest_dihedral(static_cast<int>(e)), 1e-12);
     EXPECT_GT(std::abs(mesh.edges[e].rest_theta), 1e-3);
   }
+}
+
+// ARCSim's start-up remesh of the sphere at rest: new and moved verts stay on the fitted sphere in the rest
+// shape, and the world shape stays the rest shape (the sheet is at rest, so nothing may strain it).
+TEST(SimulationReference, SphereBreakStartUpRemeshKeepsTheRestShapeOnTheSphere) {
+  REQUIRE_ARCSIM_SCENES();
+  Scene loaded_scene = load_scene((arcsim_scenes() / "conf" / "sphere-break.json").string());
+  loaded_scene.magic.remesh_at_start = false;
+  const Simulation loaded(loaded_scene);
+  const Simulation sim = load("sphere-break.json");
+  const Mesh& mesh = sim.cloths[0].mesh;
+  EXPECT_NE(mesh.faces.size(), loaded.cloths[0].mesh.faces.size()) << "the start-up remesh edited the sphere";
+  std::vector<Vec3> u;
+  for (const Vert& v : loaded.cloths[0].mesh.verts) u.push_back(v.u);
+  Sphere s;
+  ASSERT_TRUE(fit_sphere(u, s));
+  double worst_rest = 0, worst_world = 0;
+  for (const Vert& v : mesh.verts) {
+    worst_rest = std::max(worst_rest, std::abs((v.u - s.center).norm() - s.radius));
+    worst_world = std::max(worst_world, (mesh.nodes[v.node].x - v.u).norm());
+  }
+  std::printf("start-up remesh: %zu -> %zu faces; rest off the sphere %.3g m, world off rest %.3g m\n",
+              loaded.cloths[0].mesh.faces.size(), mesh.faces.size(), worst_rest, worst_world);
+  EXPECT_LT(worst_rest, 1e-12);
+  EXPECT_LT(worst_world, 1e-8);  // 1e-9 measured
 }
 
 TEST(SimulationReference, FlatSheetsGetTheLinearReference) {
