@@ -163,8 +163,14 @@ TEST(StressGlassSlowCheck, PlateShatteringAtFiveMillisecondStepsEndsWithAdaptive
   const fs::path root = repository_root("meshes/square.obj");
   ASSERT_FALSE(root.empty()) << "meshes/square.obj not found";
   TempDir dir;
-  Simulation sim = load_scene_text(
-      dir, dropped_plate_scene(root, "5e-3", "0.3", R"("adaptive_time_step": {"min_step": 1e-5},)"));
+  // The plate lands as the 2-face input refined by the first frame's remesh, as when this case was found.
+  // Remeshed at start-up instead (magic.remesh_at_start, the default since 2026-12-06) it lands as a 32-face
+  // plate and stops at step 27 on the collision budget at the finest substep: one of this drop's failing
+  // neighbours (docs/stability.md, "the start-up remesh").
+  std::string scene = dropped_plate_scene(root, "5e-3", "0.3", R"("adaptive_time_step": {"min_step": 1e-5},)");
+  const std::string cracks = R"("max_cracks": 400})";
+  scene.replace(scene.find(cracks), cracks.size(), R"("max_cracks": 400, "remesh_at_start": false})");
+  Simulation sim = load_scene_text(dir, scene);
   double lowest = 0;
   int crossing = 0, retries = 0, finest = 0;
   std::string invalid, failure;
