@@ -86,9 +86,11 @@ int run_resume_command(const std::vector<std::string>& args, const Console& cons
   if (!fs::is_directory(dir, ec)) throw InputError(dir + ": no such output folder");
   configure_threads(options.threads);
 
-  const Scene scene = load_scene((fs::path(dir) / kSceneCopyName).string());
+  Scene scene = load_scene((fs::path(dir) / kSceneCopyName).string());
   if (!options.quiet)
     for (const std::string& w : scene.warnings) console.warn(w);
+  // The saved state replaces every mesh the constructor builds, so the start-up remesh would be thrown away.
+  scene.magic.remesh_at_start = false;
   std::unique_ptr<Simulation> sim;
   int frame = -1;
   if (pos.size() == 2) {

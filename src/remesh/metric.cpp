@@ -158,6 +158,10 @@ Mat2 metric_sqrt(const Mat2& M) {
   return map_eigenvalues(M, [](double l) { return std::sqrt(std::max(l, 0.0)); });
 }
 
+Mat2 metric_signed_sqrt(const Mat2& M) {
+  return map_eigenvalues(M, [](double l) { return std::copysign(std::sqrt(std::abs(l)), l); });
+}
+
 Mat2 clamp_metric(const Mat2& M, double size_min, double size_max, double aspect_min) {
   Eigen::SelfAdjointEigenSolver<Mat2> eig(0.5 * (M + M.transpose()));
   Vec2 l = eig.eigenvalues();

@@ -19,6 +19,8 @@ Mat2 metric_max(const std::vector<Mat2>& metrics);
 // the eigenvalues.
 Mat2 metric_positive_part(const Mat2& M);
 Mat2 metric_sqrt(const Mat2& M);  // of the positive part
+// sign(l) sqrt(|l|) on each eigenvalue l: a negative eigenvalue stays negative, so a sum it enters can cancel.
+Mat2 metric_signed_sqrt(const Mat2& M);
 
 // Clamps the eigenvalues of M to [1/size_max^2, 1/size_min^2], then raises the smaller to at least
 // aspect_min^2 times the larger (limits anisotropy). Bounds that are not finite and positive are ignored.

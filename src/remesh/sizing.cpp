@@ -37,7 +37,9 @@ Mat2 perp(const Mat2& A) {
 Mat2 compression_term(const Mat32& F, const Mat2& curvature_squared, double c, double rib_stiffening) {
   const Mat2 G = F.transpose() * F - Mat2::Identity();
   const Mat2 D = G * G - 4 * c * c * rib_stiffening * perp(curvature_squared);
-  return metric_positive_part((-G + metric_sqrt(D)) / (2 * c * c));
+  // The signed root (as ARCSim's): where the curvature across a compression outweighs it, D turns negative and
+  // its root cancels the compression instead of leaving -G / c^2 behind (a rib that stiff does not buckle).
+  return metric_positive_part((-G + metric_signed_sqrt(D)) / (2 * c * c));
 }
 
 Mat2 obstacle_term(const Mesh& mesh, int f, const std::vector<ObstaclePlane>& planes) {

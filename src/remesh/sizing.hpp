@@ -12,7 +12,8 @@
 //   rest curvature S_rp^T S_rp / refine_angle^2 (paper's M_rc), S_rp the same tensor from the rest angles;
 //                  keeps curved rest shapes resolved even when the world shape is (momentarily) flat;
 //   compression    buckling term of Narain et al. 2012: the positive part of
-//                  (-G + sqrt(G^2 - 4 c^2 r perp(S^T S))) / (2 c^2), G = F^T F - I (twice the Green strain),
+//                  (-G + ssqrt(G^2 - 4 c^2 r perp(S^T S))) / (2 c^2), G = F^T F - I (twice the Green strain),
+//                  ssqrt the signed root of each eigenvalue (a negative one stays negative),
 //                  c = refine_compression (m), r = rib_stiffening, perp = rotation by 90 degrees: compression
 //                  asks for the wavelength of the buckles it will form, less so where the sheet is already
 //                  curved across the compression (a rib resists buckling);

@@ -1,6 +1,7 @@
 // The tensor max and the clamp of sizing metrics.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "remesh/metric.hpp"
@@ -90,6 +91,18 @@ TEST(MetricPositivePart, ClampsNegativeEigenvalues) {
   const Mat2 S = metric_sqrt(Vec2(4, 9).asDiagonal());
   EXPECT_NEAR(S(0, 0), 2, 1e-12);
   EXPECT_NEAR(S(1, 1), 3, 1e-12);
+}
+
+TEST(MetricSignedSqrt, KeepsTheSignOfNegativeEigenvalues) {
+  Mat2 M;
+  M << 0, 2, 2, 0;  // eigenvalues 2, -2 along (1, 1), (1, -1)
+  const Mat2 S = metric_signed_sqrt(M);
+  EXPECT_NEAR(S(0, 0), 0, 1e-12);
+  EXPECT_NEAR(S(0, 1), std::sqrt(2.0), 1e-12);
+  const Mat2 P = metric_signed_sqrt(Vec2(-4, 9).asDiagonal());
+  EXPECT_NEAR(P(0, 0), -2, 1e-12);
+  EXPECT_NEAR(P(1, 1), 3, 1e-12);
+  EXPECT_NEAR(metric_sqrt(Vec2(-4, 9).asDiagonal())(0, 0), 0, 1e-12);  // the plain root clamps instead
 }
 
 }  // namespace

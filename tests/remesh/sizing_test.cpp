@@ -69,6 +69,36 @@ TEST(Sizing, CompressionIsReducedByCurvatureAcrossIt) {
   EXPECT_NEAR(metric_eigenvalues(face_sizing_terms(rolled, f, p, {}).compression)(1), plain, 1e-6 * plain);
 }
 
+TEST(Sizing, CurvatureAcrossACompressionCanCancelIt) {
+  // Squeezed by s along x, rolled about x with radius R: G^2 - 4 c^2 perp(S^T S) has the eigenvalue
+  // (1 - s^2)^2 - 4 c^2 / R^2 along x. Gentle rolling (positive) reduces the term; tight rolling (negative) asks
+  // for no refinement at all, since the signed root then outweighs -G.
+  Mesh flat = make_grid(8, 8, 0.1, 0.1);
+  const double s = 0.95, c = 0.01;
+  SizingParams p = wide_params();
+  p.remeshing.refine_compression = c;
+  auto compression_along_x = [&](double radius) {
+    Mesh m = flat;
+    for (Node& n : m.nodes) {
+      const Vec3 u = n.x;
+      n.x = radius > 0 ? Vec3(s * u.x(), radius * std::sin(u.y() / radius), radius * (1 - std::cos(u.y() / radius)))
+                       : Vec3(s * u.x(), u.y(), 0);
+    }
+    // The term along rest x (rolling also shortens the chords along y a little: a small term there).
+    const int f = interior_face(m);
+    const Vec2 x = m.faces[f].rest_frame.transpose() * Vec3(1, 0, 0);
+    return x.dot(face_sizing_terms(m, f, p, {}).compression * x) / x.squaredNorm();
+  };
+  const double plain = compression_along_x(0);
+  EXPECT_NEAR(plain, (1 - s * s) / (c * c), 1e-6 * plain);
+  // Gentle: 4 c^2 / R^2 = 4e-4 with R = 1 against (1 - s^2)^2 = 9.5e-3: reduced a little, not cancelled.
+  const double gentle = compression_along_x(1.0);
+  EXPECT_LT(gentle, plain);
+  EXPECT_GT(gentle, 0.9 * plain);
+  // Tight: R = 0.05 gives 0.16, far above 9.5e-3: nothing left.
+  EXPECT_LT(compression_along_x(0.05), 1e-9 * plain);
+}
+
 TEST(Sizing, VelocityGradient) {
   // v = (alpha u_x, 0, 0): V = alpha e_x e_1^T, term diag(alpha^2 / refine_velocity^2, 0).
   Mesh m = make_grid(4, 4, 1.0, 1.0);
