@@ -11,6 +11,7 @@
 #include "math/errors.hpp"
 #include "mesh/validate.hpp"
 #include "plasticity/plastic_step.hpp"
+#include "sim/persistent_fallback.hpp"
 #include "sim/remesh_cloth.hpp"
 
 namespace arcsim {
@@ -498,11 +499,15 @@ std::string Simulation::substep_problem(double dt) const {
 double Simulation::adaptive_dynamics_step(double start, double dt) {
   const AdaptiveStepSpec& a = scene_.adaptive_step;
   const DynamicsSnapshot snapshot = take_snapshot(cloths);
+  PersistentFallback persistent(kPersistentFallbackLevels);
   for (;;) {
     const int substeps = 1 << substep_level_;
     const double h = dt / substeps;
-    const bool finest = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
+    // A fallback the step's start state forces (sim/persistent_fallback.hpp) is taken as at the finest substep.
+    const bool smallest = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
+    const bool finest = smallest || persistent.persistent();
     std::string problem;
+    int failed_substep = -1;
     std::vector<std::vector<int>> fallback_nodes(cloths.size());
     try {
       // Obstacles start the step where they were at its start (a retried step finds them moved on).
@@ -510,14 +515,20 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
       for (int k = 0; k < substeps && problem.empty(); ++k) {
         time_ = k + 1 == substeps ? start + dt : start + (k + 1) * h;
         move_obstacles(time_);
+        failed_substep = k;
         dynamics_step(h, finest);
         problem = substep_problem(h);
         for (size_t c = 0; c < step_fallback_nodes_.size() && c < cloths.size(); ++c)
           fallback_nodes[c].insert(fallback_nodes[c].end(), step_fallback_nodes_[c].begin(),
                                    step_fallback_nodes_[c].end());
       }
+      // substep_problem names a fallback first whenever there was one (and fallbacks are rejected).
+      if (!problem.empty())
+        persistent.record_failure(failed_substep,
+                                  a.reject_fallbacks ? step_fallback_nodes_ : std::vector<std::vector<int>>());
     } catch (const NumericalError& e) {
       problem = e.what();
+      persistent.record_failure(failed_substep, {});
     }
     if (problem.empty()) {
       for (auto& nodes : fallback_nodes) {
@@ -536,7 +547,8 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
     time_ = start + dt;
     ++time_step_stats.retries;
     time_step_stats.cause = problem;
-    if (finest) {
+    // A step taken as the finest for a persistent fallback that fails anyway (for another cause) refines on.
+    if (smallest) {
       std::ostringstream what;
       what << "step " << step_ << " (t = " << start << " to " << start + dt << " s) failed at the smallest substep "
            << h << " s (adaptive_time_step.min_step " << a.min_step << " s): " << problem

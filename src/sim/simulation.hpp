@@ -153,6 +153,9 @@ class Simulation {
     steps_at_level_ = steps;
   }
   static constexpr int kMaxSubstepLevel = 20;
+  // Attempts in a row whose first substep needs a fallback on shared nodes before the next attempt of the step
+  // is taken as the finest (sim/persistent_fallback.hpp).
+  static constexpr int kPersistentFallbackLevels = 3;
   // Fracture parameters (from the scene; tests and the ablations of tools/ change them).
   FractureParams fracture;
   // Whether the fracture module runs at the current time: enabled in the scene, and before passive_time
