@@ -38,7 +38,7 @@ Mat2 compression_term(const Mat32& F, const Mat2& curvature_squared, double c, d
   const Mat2 G = F.transpose() * F - Mat2::Identity();
   const Mat2 D = G * G - 4 * c * c * rib_stiffening * perp(curvature_squared);
   // The signed root (as ARCSim's): where the curvature across a compression outweighs it, D turns negative and
-  // its root cancels the compression instead of leaving -G / c^2 behind (a rib that stiff does not buckle).
+  // its root cancels the compression instead of leaving -G / (2 c^2) behind (a rib that stiff does not buckle).
   return metric_positive_part((-G + metric_signed_sqrt(D)) / (2 * c * c));
 }
 
