@@ -164,6 +164,7 @@ report: deps
 	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim
 	./tools/report.py --update-benchmarks docs/benchmarks.md $(if $(ARCSIM),--arcsim $(ARCSIM))
 	./tools/speed_vs_error.py --arcsim-bin bin/arcsim --out docs/img --markdown docs/speed-vs-error.md
+	./tools/fig10.py --seeds 4 --markdown docs/fig10.md --plot docs/img/fig10.png
 
 bench: deps
 	@$(MAKE) --no-print-directory $(PARALLEL) bin/arcsim-bench
