@@ -88,7 +88,7 @@ class ImpactSearch {
   std::optional<Impact> run() const {
     const double threshold = options_.contact_distance;
     const std::array<double, 4> cubic = coplanarity_cubic(cubic_order(kind_, x0_), cubic_order(kind_, x1_));
-    const std::vector<double> critical = cubic_critical_points(cubic);
+    const CubicTimes critical = cubic_critical_points(cubic);
     // How far from coplanar the pair ever gets (m), from the cubic's extremes over the step and the size of the
     // coplanarity normal.
     double cubic_max = std::max(std::abs(cubic[0]), std::abs(evaluate_cubic(cubic, 1.0)));
@@ -107,7 +107,7 @@ class ImpactSearch {
     };
     if (near_coplanar(0.0))
       if (auto hit = contact_at(0.0, true)) return hit;
-    std::vector<double> candidates = cubic_roots_in_unit_interval(cubic);
+    CubicTimes candidates = cubic_roots_in_unit_interval(cubic);
     for (double t : critical)
       if (near_coplanar(t)) candidates.push_back(t);
     if (near_coplanar(1.0)) candidates.push_back(1.0);

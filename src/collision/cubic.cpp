@@ -9,10 +9,10 @@ double evaluate_cubic(const std::array<double, 4>& c, double t) {
   return ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
 }
 
-std::vector<double> cubic_critical_points(const std::array<double, 4>& c) {
+CubicTimes cubic_critical_points(const std::array<double, 4>& c) {
   // p'(t) = A t^2 + B t + C.
   const double A = 3 * c[3], B = 2 * c[2], C = c[1];
-  std::vector<double> roots;
+  CubicTimes roots;
   if (A == 0) {
     if (B != 0) roots.push_back(-C / B);
   } else {
@@ -24,20 +24,20 @@ std::vector<double> cubic_critical_points(const std::array<double, 4>& c) {
       if (q != 0) roots.push_back(C / q);
     }
   }
-  std::vector<double> inside;
+  CubicTimes inside;
   for (double t : roots)
     if (t > 0 && t < 1) inside.push_back(t);
-  std::sort(inside.begin(), inside.end());
-  inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
+  inside.sort_unique();
   return inside;
 }
 
-std::vector<double> cubic_roots_in_unit_interval(const std::array<double, 4>& c) {
-  std::vector<double> bounds{0.0};
+CubicTimes cubic_roots_in_unit_interval(const std::array<double, 4>& c) {
+  CubicTimes bounds;
+  bounds.push_back(0.0);
   for (double t : cubic_critical_points(c)) bounds.push_back(t);
   bounds.push_back(1.0);
 
-  std::vector<double> roots;
+  CubicTimes roots;
   for (size_t k = 0; k + 1 < bounds.size(); ++k) {
     double lo = bounds[k], hi = bounds[k + 1];
     double flo = evaluate_cubic(c, lo), fhi = evaluate_cubic(c, hi);
@@ -69,8 +69,7 @@ std::vector<double> cubic_roots_in_unit_interval(const std::array<double, 4>& c)
     }
     roots.push_back(0.5 * (lo + hi));
   }
-  std::sort(roots.begin(), roots.end());
-  roots.erase(std::unique(roots.begin(), roots.end()), roots.end());
+  roots.sort_unique();
   return roots;
 }
 
