@@ -10,6 +10,21 @@ uint64_t mix(uint64_t h, uint64_t value) {
   return h * 0x100000001b3ULL;
 }
 
+// Appends the per-face lists of owned items: item i (global index first + i) belongs to local face owner[i]
+// (kNone: to none). Each face's list holds its items in ascending order; begin gets one offset per face.
+void append_owned(const std::vector<int>& owner, int first, int face_count, std::vector<int>& begin,
+                  std::vector<int>& items) {
+  std::vector<int> next(face_count + 1, 0);
+  for (int f : owner)
+    if (f != kNone) ++next[f + 1];
+  for (int f = 0; f < face_count; ++f) next[f + 1] += next[f];
+  const int base = static_cast<int>(items.size());
+  for (int f = 0; f < face_count; ++f) begin.push_back(base + next[f]);
+  items.resize(base + next[face_count]);
+  for (size_t i = 0; i < owner.size(); ++i)
+    if (owner[i] != kNone) items[base + next[owner[i]]++] = first + static_cast<int>(i);
+}
+
 void append_mesh(const ContactBody& body, ContactStage stage, double dt, ContactGeometry& g) {
   const Mesh& mesh = *body.mesh;
   ContactGeometry::Range r;
@@ -67,34 +82,37 @@ void append_mesh(const ContactBody& body, ContactStage stage, double dt, Contact
   r.topology = topology;
   g.meshes.push_back(r);
 
-  // Ownership: the first live face incident to each node and edge.
+  // Ownership: the first live face incident to each node and edge, listed per face in ascending order
+  // (counting sort into the flat lists: one pass, no list per face).
+  const int face_count = r.face_end - r.face_begin;
   std::vector<int> node_owner(mesh.nodes.size(), kNone);
   for (int f = r.face_begin; f < r.face_end; ++f)
     for (int n : g.faces[f])
-      if (n != kNone && node_owner[n - r.node_begin] == kNone) node_owner[n - r.node_begin] = f;
-  std::vector<std::vector<int>> nodes_of(r.face_end - r.face_begin), edges_of(r.face_end - r.face_begin);
-  for (size_t n = 0; n < node_owner.size(); ++n)
-    if (node_owner[n] != kNone) nodes_of[node_owner[n] - r.face_begin].push_back(r.node_begin + static_cast<int>(n));
+      if (n != kNone && node_owner[n - r.node_begin] == kNone) node_owner[n - r.node_begin] = f - r.face_begin;
+  std::vector<int> edge_owner(r.edge_end - r.edge_begin, kNone);
   for (int e = r.edge_begin; e < r.edge_end; ++e) {
-    const auto& ef = g.edge_faces[e];
     int owner = kNone;
-    for (int f : ef)
+    for (int f : g.edge_faces[e])
       if (f != kNone && (owner == kNone || f < owner)) owner = f;
-    if (owner != kNone) edges_of[owner - r.face_begin].push_back(e);
+    if (owner != kNone) edge_owner[e - r.edge_begin] = owner - r.face_begin;
   }
-  for (int f = 0; f < r.face_end - r.face_begin; ++f) {
-    g.owned_node_begin.push_back(static_cast<int>(g.owned_nodes.size()));
-    g.owned_nodes.insert(g.owned_nodes.end(), nodes_of[f].begin(), nodes_of[f].end());
-    g.owned_edge_begin.push_back(static_cast<int>(g.owned_edges.size()));
-    g.owned_edges.insert(g.owned_edges.end(), edges_of[f].begin(), edges_of[f].end());
-  }
+  append_owned(node_owner, r.node_begin, face_count, g.owned_node_begin, g.owned_nodes);
+  append_owned(edge_owner, r.edge_begin, face_count, g.owned_edge_begin, g.owned_edges);
 }
 
 }  // namespace
 
 void build_contact_geometry(const std::vector<ContactBody>& bodies, ContactStage stage, double dt,
                             ContactGeometry& g) {
-  g = ContactGeometry();
+  // Cleared, not replaced: the vectors keep their capacity from the last build (two builds a step).
+  g.meshes.clear();
+  for (auto* v : {&g.x0, &g.x1, &g.v, &g.rest}) v->clear();
+  for (auto* v : {&g.mass, &g.area, &g.face_area}) v->clear();
+  for (auto* v : {&g.node_mesh, &g.owned_node_begin, &g.owned_nodes, &g.owned_edge_begin, &g.owned_edges})
+    v->clear();
+  g.edges.clear();
+  g.edge_faces.clear();
+  g.faces.clear();
   for (const ContactBody& body : bodies) append_mesh(body, stage, dt, g);
   g.owned_node_begin.push_back(static_cast<int>(g.owned_nodes.size()));
   g.owned_edge_begin.push_back(static_cast<int>(g.owned_edges.size()));
