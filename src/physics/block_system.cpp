@@ -147,6 +147,30 @@ void BlockSystem::to_csc(Eigen::SparseMatrix<double>& out) const {
   }
 }
 
+void BlockSystem::scatter_upper(const std::vector<int>& place, double* out) const {
+  for (int k = 0; k < pattern->block_count(); ++k) {
+    const bool diagonal = pattern->block_row(k) == pattern->block_col(k);
+    for (int b = 0; b < 3; ++b) {
+      const int offset = pattern->block_value_offset(k, b);
+      const int last = diagonal ? b : 2;
+      for (int a = 0; a <= last; ++a) out[place[offset + a]] = blocks[k](b, a);
+    }
+  }
+}
+
+const int* SupernodalLLT::permutation() const {
+  return m_cholmodFactor ? static_cast<const int*>(m_cholmodFactor->Perm) : nullptr;
+}
+
+void SupernodalLLT::factorize_permuted_lower(cholmod_sparse& lower) {
+  // As Eigen's factorize does, minus the transpose cholmod_factorize_p would make of an upper matrix.
+  cholmod_common& common = cholmod();
+  common.status = CHOLMOD_OK;
+  cholmod_super_numeric(&lower, nullptr, m_shiftOffset, m_cholmodFactor, &common);
+  m_info = m_cholmodFactor->minor == m_cholmodFactor->n ? Eigen::Success : Eigen::NumericalIssue;
+  m_factorizationIsOk = true;
+}
+
 int SupernodalLLT::failed_row() const {
   const cholmod_factor* L = m_cholmodFactor;
   if (!L || L->minor >= L->n) return -1;
@@ -163,6 +187,10 @@ CholeskySolver::CholeskySolver(CholeskySolver&& other) noexcept { *this = std::m
 CholeskySolver& CholeskySolver::operator=(CholeskySolver&& other) noexcept {
   llt_ = std::move(other.llt_);
   matrix_.swap(other.matrix_);
+  lower_start_.swap(other.lower_start_);
+  lower_row_.swap(other.lower_row_);
+  lower_place_.swap(other.lower_place_);
+  lower_value_.swap(other.lower_value_);
   analysed_pattern_ = other.analysed_pattern_;
   factor_current_ = other.factor_current_;
   settings_ = other.settings_;
@@ -190,13 +218,63 @@ bool CholeskySolver::factorize(const BlockSystem& system) {
     llt_->analyzePattern(matrix_);
     analysed_pattern_ = id;
     ++analyses_;
-  } else {
-    system.to_csc(matrix_);
+    prepare_permuted_layout();
   }
-  return factorize_matrix();
+  return factorize_matrix(system);
 }
 
-bool CholeskySolver::factorize_matrix() {
+void CholeskySolver::prepare_permuted_layout() {
+  const int n = static_cast<int>(matrix_.rows());
+  const int* perm = llt_->permutation();
+  std::vector<int> inverse(n);
+  for (int k = 0; k < n; ++k) inverse[perm ? perm[k] : k] = k;
+  // Entry (i, j) of A's upper triangle is entry (max, min) of P A P''s lower one: count per column, then
+  // place each column's entries in ascending row order (CHOLMOD's transpose yields sorted columns).
+  const int nnz = static_cast<int>(matrix_.nonZeros());
+  const int* outer = matrix_.outerIndexPtr();
+  const int* inner = matrix_.innerIndexPtr();
+  std::vector<std::pair<int, int>> target(nnz);  // (permuted row, permuted column) per value index
+  lower_start_.assign(n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int q = outer[j]; q < outer[j + 1]; ++q) {
+      const int a = inverse[inner[q]], b = inverse[j];
+      target[q] = {std::max(a, b), std::min(a, b)};
+      ++lower_start_[target[q].second + 1];
+    }
+  for (int c = 0; c < n; ++c) lower_start_[c + 1] += lower_start_[c];
+  std::vector<int> by_column(nnz);
+  {
+    std::vector<int> next(lower_start_.begin(), lower_start_.end() - 1);
+    for (int q = 0; q < nnz; ++q) by_column[next[target[q].second]++] = q;
+  }
+  lower_row_.resize(nnz);
+  lower_place_.resize(nnz);
+  lower_value_.assign(nnz, 0.0);
+  for (int c = 0; c < n; ++c) {
+    const auto begin = by_column.begin() + lower_start_[c], end = by_column.begin() + lower_start_[c + 1];
+    std::sort(begin, end, [&](int p, int q) { return target[p].first < target[q].first; });
+    for (auto it = begin; it != end; ++it) {
+      const int pos = static_cast<int>(it - by_column.begin());
+      lower_row_[pos] = target[*it].first;
+      lower_place_[*it] = pos;
+    }
+  }
+}
+
+bool CholeskySolver::factorize_matrix(const BlockSystem& system) {
+  system.scatter_upper(lower_place_, lower_value_.data());
+  cholmod_sparse lower{};
+  lower.nrow = lower.ncol = lower_start_.size() - 1;
+  lower.nzmax = lower_value_.size();
+  lower.p = lower_start_.data();
+  lower.i = lower_row_.data();
+  lower.x = lower_value_.data();
+  lower.stype = -1;
+  lower.itype = CHOLMOD_INT;
+  lower.xtype = CHOLMOD_REAL;
+  lower.dtype = CHOLMOD_DOUBLE;
+  lower.sorted = 1;
+  lower.packed = 1;
   // CHOLMOD's supernodal numeric phase opens an OpenMP team of a compiled-in size (4 threads in Debian's build)
   // for every supernode, whatever the machine or --threads; its parallel part only copies entries into distinct
   // places (the arithmetic is in the serial BLAS). On 2 cores those teams oversubscribed and their barriers cost
@@ -206,7 +284,7 @@ bool CholeskySolver::factorize_matrix() {
   // every such region runs on the calling thread at once. The factor does not depend on the team size.
   const int levels_before = omp_get_max_active_levels();
   omp_set_max_active_levels(0);
-  llt_->factorize(matrix_);
+  llt_->factorize_permuted_lower(lower);
   omp_set_max_active_levels(levels_before);
   ++factorizations_;
   factor_current_ = llt_->info() == Eigen::Success;

@@ -81,6 +81,8 @@ struct BlockSystem {
   VecX multiply(const VecX& x) const;
   // Fills `out` (with the pattern's structure) with the upper triangle.
   void to_csc(Eigen::SparseMatrix<double>& out) const;
+  // Writes the upper triangle's entries elsewhere: the entry to_csc puts at value index q goes to out[place[q]].
+  void scatter_upper(const std::vector<int>& place, double* out) const;
 };
 
 // Looks up the block ids of all row pairs of an element once per topology (-1 where a row is -1: a node held
@@ -118,6 +120,11 @@ class SupernodalLLT : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // The matrix row (in the matrix's own order, not CHOLMOD's fill-reducing permutation) whose pivot was not
   // positive in the last factorisation; -1 if it succeeded or none ran.
   int failed_row() const;
+  // The fill-reducing permutation of the last analysis: row k of the permuted matrix is row permutation()[k].
+  const int* permutation() const;
+  // Numeric factorisation from tril(P A P') (P the analysis's permutation), sorted compressed columns: what
+  // factorize(A) hands CHOLMOD's supernodal phase after transposing A into that form, so the factor is the same.
+  void factorize_permuted_lower(cholmod_sparse& lower);
 };
 
 // What one solve_system did.
@@ -158,14 +165,21 @@ class CholeskySolver {
   int failed_row() const { return llt_ ? llt_->failed_row() : -1; }
 
  private:
-  // Factorises matrix_ (already filled); false if that failed.
-  bool factorize_matrix();
+  // Lays out tril(P A P') for the pattern just analysed and where each entry of A's upper triangle goes in it.
+  void prepare_permuted_layout();
+  // Factorises the system's matrix in that layout; false if that failed.
+  bool factorize_matrix(const BlockSystem& system);
   // Up to pcg_max_iterations of conjugate gradients preconditioned with the kept factor; false if they did not
   // reach the tolerance (or met non-positive curvature).
   bool conjugate_gradients(const BlockSystem& system, VecX& x, int& iterations);
 
   std::unique_ptr<SupernodalLLT> llt_;
   Eigen::SparseMatrix<double> matrix_;
+  // tril(P A P') in compressed columns, refilled at every factorisation through lower_place_ (indexed like the
+  // values of matrix_). WHY: CHOLMOD otherwise transposes the whole matrix into this form at every call, a
+  // tenth of the factorisation of a small sheet's system.
+  std::vector<int> lower_start_, lower_row_, lower_place_;
+  std::vector<double> lower_value_;
   uint64_t analysed_pattern_ = 0;
   bool factor_current_ = false;  // llt_ holds a factorisation of a matrix on analysed_pattern_
   SolverSettings settings_;
