@@ -4,6 +4,7 @@
 // against each other. Pairs sharing a node are dropped.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <tuple>
 #include <vector>
@@ -26,18 +27,46 @@ struct PrimitivePair {
 // (vertex, face corners) or (edge a nodes, edge b nodes); VE uses (vertex, edge nodes, kNone).
 std::array<int, 4> pair_nodes(const ContactGeometry& g, const PrimitivePair& p);
 
+// The candidates that pass every test of topology alone (pairs sharing a node dropped, vertex-edge pairs only
+// of boundary primitives), listed from the face pairs whose boxes overlap once every node's box is grown by a
+// slack, and kept across searches (a Verlet list) while every node's box stays inside its grown box: any pair
+// whose boxes overlap then is on the list, so a search only filters the list by boxes and moved flags. WHY:
+// a sheet's nodes move little from one step to the next, and on small sheets finding the face pairs again
+// (a traversal that reports every neighbouring face) cost more than all the tests they lead to.
+struct CandidateList {
+  bool ready = false;
+  // What the list was made for: the geometry's connectivity and the search's options.
+  std::vector<ContactGeometry::Range> meshes;
+  std::vector<std::array<int, 3>> faces;
+  std::vector<std::array<int, 2>> edges, edge_faces;
+  std::vector<int> owned_node_begin, owned_nodes, owned_edge_begin, owned_edges;
+  double margin = 0;
+  bool vertex_edge = false;
+  std::vector<Aabb> grown;  // per node: the box its search box must stay inside
+  std::array<std::vector<PrimitivePair>, 3> by_kind;  // the candidates, by PairKind, in no particular order
+  int served = 0;   // searches the list has served
+  int backoff = 1;  // searches to go without a list after the next list that does not pay
+  int skip = 0;     // searches left to go without a list
+};
+
 // One BVH per mesh of the geometry, kept across steps: rebuilt when the mesh's topology changes, refitted
-// otherwise.
+// otherwise. Also the candidate lists of the swept and the static searches.
 class BvhCache {
  public:
   void update(const ContactGeometry& g, const std::vector<Aabb>& face_boxes);
   const Bvh& tree(int mesh) const { return trees_[mesh]; }
   int builds() const { return builds_; }
+  // How many times a candidate list was made (each search that could not reuse one).
+  int list_builds() const { return list_builds_; }
+  CandidateList& list(bool swept) { return lists_[swept ? 1 : 0]; }
+  void count_list_build() { ++list_builds_; }
 
  private:
   std::vector<Bvh> trees_;
   std::vector<uint64_t> topology_;
+  std::array<CandidateList, 2> lists_;
   int builds_ = 0;
+  int list_builds_ = 0;
 };
 
 struct CandidateOptions {

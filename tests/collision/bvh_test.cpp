@@ -249,5 +249,75 @@ TEST(Candidates, BvhIsRebuiltOnlyWhenTopologyChanges) {
   EXPECT_EQ(cache.builds(), 3);
 }
 
+// Moves every sheet node of the geometry (both ends of its step) by up to `step` per axis.
+void jiggle(ContactGeometry& g, std::mt19937& rng, double step) {
+  std::uniform_real_distribution<double> U(-step, step);
+  for (int n = 0; n < g.node_count(); ++n) {
+    if (!g.movable(n)) continue;
+    const Vec3 d(U(rng), U(rng), U(rng));
+    g.x0[n] += d;
+    g.x1[n] += d;
+  }
+}
+
+TEST(Candidates, AKeptListFindsWhatAFreshSearchFinds) {
+  // Small moves stay within the list's slack (the list is reused), large ones leave it (a new list is made):
+  // either way the kept cache finds exactly what a fresh cache and brute force find.
+  for (bool swept : {true, false}) {
+    TwoMeshes m(5);
+    std::mt19937 rng(7);
+    BvhCache kept;
+    CandidateOptions options;
+    options.margin = 0.01;
+    options.swept = swept;
+    options.vertex_edge = !swept;
+    find_candidates(m.g, kept, options);
+    EXPECT_EQ(kept.list_builds(), 1);
+    for (int round = 0; round < 12; ++round) {
+      jiggle(m.g, rng, round % 4 == 3 ? 0.05 : 0.002);
+      BvhCache fresh;
+      const auto found = find_candidates(m.g, kept, options);
+      EXPECT_TRUE(found == find_candidates(m.g, fresh, options)) << "round " << round << " swept " << swept;
+      if (!swept) continue;  // brute_candidates has no vertex-edge pairs
+      EXPECT_TRUE(found == brute_candidates(m.g, options.margin, swept)) << "round " << round;
+    }
+    EXPECT_GT(kept.list_builds(), 1);   // the large moves left the slack
+    EXPECT_LT(kept.list_builds(), 12);  // the small ones did not
+  }
+}
+
+TEST(Candidates, AKeptListServesSearchesWithMovedFlags) {
+  TwoMeshes m(6);
+  std::mt19937 rng(8);
+  BvhCache kept;
+  CandidateOptions options;
+  options.margin = 0.01;
+  options.swept = true;
+  find_candidates(m.g, kept, options);
+  std::vector<char> moved(m.g.node_count(), 0);
+  for (int n = 0; n < m.g.node_count(); n += 3) moved[n] = 1;
+  options.moved = &moved;
+  for (double step : {0.001, 0.05}) {  // within the slack, then beyond it
+    jiggle(m.g, rng, step);
+    BvhCache fresh;
+    EXPECT_TRUE(find_candidates(m.g, kept, options) == find_candidates(m.g, fresh, options)) << step;
+  }
+}
+
+TEST(Candidates, AKeptListIsDroppedWhenTheTopologyChanges) {
+  TwoMeshes m(3);
+  BvhCache kept;
+  CandidateOptions options;
+  options.margin = 0.01;
+  find_candidates(m.g, kept, options);
+  // Same positions, new sheet connectivity (flipped diagonals): the list no longer fits.
+  m.sheet = testing::make_grid(8, 8, 1, 1, testing::Diagonal::kForward);
+  for (Node& n : m.sheet.nodes) n.mass = 0.01;
+  build_contact_geometry({{&m.sheet, true}, {&m.plate, false}}, ContactStage::kAfterStep, 0.01, m.g);
+  BvhCache fresh;
+  EXPECT_TRUE(find_candidates(m.g, kept, options) == find_candidates(m.g, fresh, options));
+  EXPECT_EQ(kept.list_builds(), 2);
+}
+
 }  // namespace
 }  // namespace arcsim

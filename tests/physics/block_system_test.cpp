@@ -277,5 +277,45 @@ TEST(CholeskySolverPcg, AnIndefiniteMatrixStillFailsUnderTheIteration) {
   EXPECT_FALSE(solver.solve_system(bad.system, x, report));
 }
 
+// The solver hands CHOLMOD the permuted lower triangle through a map kept per analysis: its factor must be the
+// one CHOLMOD makes from the upper triangle itself (Eigen's wrapper, same ordering), bit for bit, before and
+// after the values change on the same pattern, and after a new pattern.
+TEST(CholeskySolver, PermutedLayoutGivesCholmodsOwnFactor) {
+  std::mt19937 rng(11);
+  const int n = 40;
+  std::vector<std::pair<int, int>> pairs;
+  for (int k = 0; k < 120; ++k) pairs.emplace_back(static_cast<int>(rng() % n), static_cast<int>(rng() % n));
+  BlockPattern pattern;
+  pattern.build(n, pairs);
+  CholeskySolver solver;
+  for (int round = 0; round < 3; ++round) {
+    if (round == 2) {  // a new pattern: a new analysis and a new map
+      pairs.emplace_back(0, n - 1);
+      pattern.build(n, pairs);
+    }
+    BlockSystem system;
+    system.reset(pattern);
+    for (int k = 0; k < pattern.block_count(); ++k) {
+      const Mat3 r = Mat3::Random();
+      system.blocks[k] = pattern.block_row(k) == pattern.block_col(k) ? Mat3(r * r.transpose() + 8 * Mat3::Identity())
+                                                                        : Mat3(0.1 * r);
+    }
+    system.rhs = VecX::Random(3 * n);
+    ASSERT_TRUE(solver.factorize(system));
+    const VecX ours = solver.solve(system.rhs);
+
+    Eigen::SparseMatrix<double> upper;
+    system.to_csc(upper);
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> reference;
+    reference.cholmod().nmethods = 1;
+    reference.cholmod().method[0].ordering = CHOLMOD_AMD;
+    reference.compute(upper);
+    ASSERT_EQ(reference.info(), Eigen::Success);
+    const VecX expected = reference.solve(system.rhs);
+    EXPECT_TRUE(ours == expected) << "round " << round << ": " << (ours - expected).norm();
+  }
+  EXPECT_EQ(solver.analyses(), 2);
+}
+
 }  // namespace
 }  // namespace arcsim
