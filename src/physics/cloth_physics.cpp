@@ -206,14 +206,16 @@ struct ElementResult {
   // Every field is written before it is read: no zero-filling of the (large) buffer on allocation.
   ElementResult() {}
   double energy;
+  double scale;  // the system takes scale * hessian (scaled block by block as it is scattered: only the lower
+                 // blocks are needed, and scaling them there gives the same products)
   Eigen::Matrix<double, 3 * N, 1> rhs;
-  Eigen::Matrix<double, 3 * N, 3 * N> K;
+  Eigen::Matrix<double, 3 * N, 3 * N> hessian;
 };
 
 template <int N>
 void scatter(const std::array<int, N>& dofs, const std::array<int, N * N>& blocks, const ElementResult<N>& r,
              BlockSystem& system) {
-  system.add_element<N>(dofs, blocks, r.K, 1.0);
+  system.add_element<N>(dofs, blocks, r.hessian, r.scale);
   for (int i = 0; i < N; ++i)
     if (dofs[i] >= 0) system.rhs.segment<3>(3 * dofs[i]) += r.rhs.template segment<3>(3 * i);
 }
@@ -278,17 +280,14 @@ double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements,
 #pragma omp parallel for schedule(static) if (end - begin >= kParallelMinElements)
     for (int i = begin; i < end; ++i) {
       const Element& el = elements[i];
-      double element_energy;
-      Eigen::Matrix<double, 3 * N, 1> gradient;
-      Eigen::Matrix<double, 3 * N, 3 * N> hessian;
-      evaluate(el, element_energy, gradient, hessian);
       ElementResult<N>& r = results[i - begin];
-      r.energy = element_energy;
-      r.K = (how.stiffness_scale + how.damping_scale * el.damping) * hessian;
+      Eigen::Matrix<double, 3 * N, 1> gradient;
+      evaluate(el, r.energy, gradient, r.hessian);
+      r.scale = how.stiffness_scale + how.damping_scale * el.damping;
       r.rhs = -how.force_scale * gradient;
       if (need_velocity)
         r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 (hessian * gather_velocity<N>(mesh, el.nodes));
+                 (r.hessian * gather_velocity<N>(mesh, el.nodes));
     }
     for (int i = begin; i < end; ++i) {
       energy += results[i - begin].energy;

@@ -61,7 +61,8 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
   // Gauss-Newton part 2 sum_ij Q_ij grad_i grad_j^T. Slot p's rows of the three gradients form a 3x3 matrix
   // G_p (column i: hinge i's gradient at slot p, zero where slot p is not in hinge i), so that block (p, q) is
   // 2 G_p Q G_q^T: six products G_p Q, then the upper blocks, mirrored (Q is symmetric).
-  out.hessian.setZero();
+  // Every block is written below when the three wings exist; only a border face's missing rows stay zero.
+  if (!(has_wing[0] && has_wing[1] && has_wing[2])) out.hessian.setZero();
   std::array<Mat3, 6> G;
   for (Mat3& g : G) g.setZero();
   for (int i = 0; i < 3; ++i) {
