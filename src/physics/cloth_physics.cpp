@@ -200,22 +200,20 @@ VecX internal_forces(const Mesh& mesh, const ElementCache& cache) {
 
 namespace {
 
-// Element results computed in parallel, then scattered serially in element order (deterministic).
-template <int N>
+// Element results computed in parallel, then scattered serially in element order (deterministic). Terms is the
+// element's evaluation (energy, gradient, hessian), written in place.
+template <int N, typename Terms>
 struct ElementResult {
-  // Every field is written before it is read: no zero-filling of the (large) buffer on allocation.
-  ElementResult() {}
-  double energy;
+  Terms terms;
   double scale;  // the system takes scale * hessian (scaled block by block as it is scattered: only the lower
                  // blocks are needed, and scaling them there gives the same products)
   Eigen::Matrix<double, 3 * N, 1> rhs;
-  Eigen::Matrix<double, 3 * N, 3 * N> hessian;
 };
 
-template <int N>
-void scatter(const std::array<int, N>& dofs, const std::array<int, N * N>& blocks, const ElementResult<N>& r,
+template <int N, typename Terms>
+void scatter(const std::array<int, N>& dofs, const std::array<int, N * N>& blocks, const ElementResult<N, Terms>& r,
              BlockSystem& system) {
-  system.add_element<N>(dofs, blocks, r.hessian, r.scale);
+  system.add_element<N>(dofs, blocks, r.terms.hessian, r.scale);
   for (int i = 0; i < N; ++i)
     if (dofs[i] >= 0) system.rhs.segment<3>(3 * dofs[i]) += r.rhs.template segment<3>(3 * i);
 }
@@ -268,29 +266,28 @@ constexpr int kAssemblyChunk = 8192;
 // on ARCSim's square.json (172 faces) on a loaded 2-core machine: 24 ms per step with 2 threads, 1.7 with one.
 constexpr int kParallelMinElements = 2048;
 
-template <int N, typename Element, typename Evaluate>
+template <int N, typename Terms, typename Element, typename Evaluate>
 double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements, const InternalAssembly& how,
                          Evaluate evaluate, BlockSystem& system) {
   const int count = static_cast<int>(elements.size());
   const bool need_velocity = how.velocity_scale != 0 || how.damping_velocity_scale != 0;
-  std::vector<ElementResult<N>> results(std::min(count, kAssemblyChunk));
+  std::vector<ElementResult<N, Terms>> results(std::min(count, kAssemblyChunk));
   double energy = 0;
   for (int begin = 0; begin < count; begin += kAssemblyChunk) {
     const int end = std::min(count, begin + kAssemblyChunk);
 #pragma omp parallel for schedule(static) if (end - begin >= kParallelMinElements)
     for (int i = begin; i < end; ++i) {
       const Element& el = elements[i];
-      ElementResult<N>& r = results[i - begin];
-      Eigen::Matrix<double, 3 * N, 1> gradient;
-      evaluate(el, r.energy, gradient, r.hessian);
+      ElementResult<N, Terms>& r = results[i - begin];
+      evaluate(el, r.terms);
       r.scale = how.stiffness_scale + how.damping_scale * el.damping;
-      r.rhs = -how.force_scale * gradient;
+      r.rhs = -how.force_scale * r.terms.gradient;
       if (need_velocity)
         r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 (r.hessian * gather_velocity<N>(mesh, el.nodes));
+                 (r.terms.hessian * gather_velocity<N>(mesh, el.nodes));
     }
     for (int i = begin; i < end; ++i) {
-      energy += results[i - begin].energy;
+      energy += results[i - begin].terms.energy;
       scatter<N>(elements[i].dofs, elements[i].blocks, results[i - begin], system);
     }
   }
@@ -302,25 +299,18 @@ double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements,
 double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& faces,
                               const std::vector<BendingElement>& bending, const InternalAssembly& how,
                               BlockSystem& system) {
-  double energy = assemble_elements<3>(
+  double energy = assemble_elements<3, MembraneTerms>(
       mesh, faces, how,
-      [&](const FaceElement& el, double& e, Vec9& g, Mat9& H) {
-        const MembraneTerms t =
-            membrane_terms(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x, mesh.nodes[el.nodes[2]].x,
+      [&](const FaceElement& el, MembraneTerms& t) {
+        t = membrane_terms(mesh.nodes[el.nodes[0]].x, mesh.nodes[el.nodes[1]].x, mesh.nodes[el.nodes[2]].x,
                            el.Dm_inv, el.area, el.k, 1.0, HessianKind::kProjected);
-        e = t.energy;
-        g = t.gradient;
-        H = t.hessian;
       },
       system);
-  energy += assemble_elements<6>(
+  energy += assemble_elements<6, PlateBendingTerms>(
       mesh, bending, how,
-      [&](const BendingElement& el, double& e, Vec18& g, Mat18& H) {
-        const PlateBendingTerms t = plate_bending_terms(gather_positions(mesh, el.nodes), el.has_wing,
-                                                        el.rest_theta, el.Q, HessianKind::kProjected);
-        e = t.energy;
-        g = t.gradient;
-        H = t.hessian;
+      [&](const BendingElement& el, PlateBendingTerms& t) {
+        plate_bending_terms(gather_positions(mesh, el.nodes), el.has_wing, el.rest_theta, el.Q,
+                            HessianKind::kProjected, t);
       },
       system);
   return energy;

@@ -39,6 +39,14 @@ double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool,
 PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                                       const Vec3& rest_theta, const Mat3& Q, HessianKind hessian) {
   PlateBendingTerms out;
+  plate_bending_terms(x, has_wing, rest_theta, Q, hessian, out);
+  return out;
+}
+
+void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing, const Vec3& rest_theta,
+                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out) {
+  out.gradient.setZero();
+  out.theta.setZero();
   std::array<Vec12, 3> grad;
   Vec3 delta = Vec3::Zero();
   for (int i = 0; i < 3; ++i) {
@@ -56,7 +64,7 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
     const auto s = plate_hinge_slots(i);
     for (int a = 0; a < 4; ++a) out.gradient.segment<3>(3 * s[a]) += 2 * Qd[i] * grad[i].segment<3>(3 * a);
   }
-  if (hessian == HessianKind::kNone) return out;
+  if (hessian == HessianKind::kNone) return;
 
   // Gauss-Newton part 2 sum_ij Q_ij grad_i grad_j^T. Slot p's rows of the three gradients form a 3x3 matrix
   // G_p (column i: hinge i's gradient at slot p, zero where slot p is not in hinge i), so that block (p, q) is
@@ -92,7 +100,6 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
           out.hessian.block<3, 3>(3 * s[a], 3 * s[b]) += 2 * Qd[i] * H.block<3, 3>(3 * a, 3 * b);
     }
   }
-  return out;
 }
 
 }  // namespace arcsim

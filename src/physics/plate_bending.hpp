@@ -54,6 +54,10 @@ struct PlateBendingTerms {
 // dihedral angles of the three edges. kProjected gives the Gauss-Newton Hessian 2 sum Q_ij grad_i grad_j^T.
 PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                                       const Vec3& rest_theta, const Mat3& Q, HessianKind hessian);
+// The same, written over `out` (every field): the assembly evaluates into its own buffer, with no copy of the
+// 18x18 Hessian.
+void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing, const Vec3& rest_theta,
+                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out);
 
 // The energy alone (J), equal to plate_bending_terms(...).energy, without the angles' gradients (for energy
 // checks that evaluate every element several times per step).
