@@ -34,29 +34,38 @@ void append_mesh(const ContactBody& body, ContactStage stage, double dt, Contact
   r.face_begin = static_cast<int>(g.faces.size());
   const int mesh_index = static_cast<int>(g.meshes.size());
 
-  for (const Node& n : mesh.nodes) {
-    Vec3 start = n.x0, end = n.x, velocity = n.v;
+  // Sized once, then written in place (these run twice a step).
+  const int node_end = r.node_begin + static_cast<int>(mesh.nodes.size());
+  for (auto* v : {&g.x0, &g.x1, &g.v, &g.rest}) v->resize(node_end);
+  g.mass.resize(node_end);
+  g.area.resize(node_end);
+  g.node_mesh.resize(node_end);
+  for (size_t i = 0; i < mesh.nodes.size(); ++i) {
+    const Node& n = mesh.nodes[i];
+    const int k = r.node_begin + static_cast<int>(i);
+    g.x0[k] = n.x0;
+    g.x1[k] = n.x;
+    g.v[k] = n.v;
     if (!body.deformable) {
-      velocity = dt > 0 ? Vec3((n.x - n.x0) / dt) : Vec3::Zero();
+      g.v[k] = dt > 0 ? Vec3((n.x - n.x0) / dt) : Vec3::Zero();
     } else if (stage == ContactStage::kBeforeStep) {
-      start = n.x;
-      end = n.x + dt * n.v;
+      g.x0[k] = n.x;
+      g.x1[k] = n.x + dt * n.v;
     }
-    g.x0.push_back(start);
-    g.x1.push_back(end);
-    g.v.push_back(velocity);
-    g.mass.push_back(body.deformable && n.mass > 0 ? n.mass : kInfinity);
-    g.area.push_back(0);
-    g.node_mesh.push_back(mesh_index);
-    g.rest.push_back(body.deformable && !n.verts.empty() ? mesh.verts[n.verts[0]].u : Vec3::Zero());
+    g.mass[k] = body.deformable && n.mass > 0 ? n.mass : kInfinity;
+    g.area[k] = 0;
+    g.node_mesh[k] = mesh_index;
+    g.rest[k] = body.deformable && !n.verts.empty() ? mesh.verts[n.verts[0]].u : Vec3::Zero();
   }
   uint64_t topology = mix(mesh.nodes.size(), mesh.faces.size());
+  g.faces.resize(r.face_begin + mesh.faces.size());
+  g.face_area.resize(g.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     const Face& face = mesh.faces[f];
-    std::array<int, 3> nodes{kNone, kNone, kNone};
+    std::array<int, 3>& nodes = g.faces[r.face_begin + f];
+    nodes = {kNone, kNone, kNone};
     if (!face.dead)
-      for (int i = 0; i < 3; ++i) nodes[i] = r.node_begin + mesh.face_node(static_cast<int>(f), i);
-    g.faces.push_back(nodes);
+      for (int i = 0; i < 3; ++i) nodes[i] = r.node_begin + mesh.verts[face.v[i]].node;
     for (int i = 0; i < 3; ++i) topology = mix(topology, static_cast<uint64_t>(nodes[i] - r.node_begin));
     double area = 0;
     if (!face.dead) {
@@ -64,17 +73,20 @@ void append_mesh(const ContactBody& body, ContactStage stage, double dt, Contact
                              : 0.5 * (g.x0[nodes[1]] - g.x0[nodes[0]]).cross(g.x0[nodes[2]] - g.x0[nodes[0]]).norm();
       for (int i = 0; i < 3; ++i) g.area[nodes[i]] += area / 3;
     }
-    g.face_area.push_back(area);
+    g.face_area[r.face_begin + f] = area;
   }
-  for (const Edge& e : mesh.edges) {
+  g.edges.resize(r.edge_begin + mesh.edges.size());
+  g.edge_faces.resize(g.edges.size());
+  for (size_t i = 0; i < mesh.edges.size(); ++i) {
+    const Edge& e = mesh.edges[i];
+    const size_t k = r.edge_begin + i;
     if (e.dead) {
-      g.edges.push_back({kNone, kNone});
-      g.edge_faces.push_back({kNone, kNone});
+      g.edges[k] = {kNone, kNone};
+      g.edge_faces[k] = {kNone, kNone};
       continue;
     }
-    g.edges.push_back({r.node_begin + e.n[0], r.node_begin + e.n[1]});
-    g.edge_faces.push_back({e.f[0] == kNone ? kNone : r.face_begin + e.f[0],
-                            e.f[1] == kNone ? kNone : r.face_begin + e.f[1]});
+    g.edges[k] = {r.node_begin + e.n[0], r.node_begin + e.n[1]};
+    g.edge_faces[k] = {e.f[0] == kNone ? kNone : r.face_begin + e.f[0], e.f[1] == kNone ? kNone : r.face_begin + e.f[1]};
   }
   r.node_end = g.node_count();
   r.edge_end = static_cast<int>(g.edges.size());
