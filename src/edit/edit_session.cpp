@@ -262,6 +262,13 @@ EditResult EditSession::flip_edge(int e) {
 EditResult EditSession::collapse_edge(int e, int remove_side) {
   const EditKind kind = EditKind::kCollapseEdge;
   EditResult r;
+  // An edit the connectivity rules out is refused before the world guard (which costs ~100 times more): the
+  // remesher asks for many such collapses (boundary nodes along interior edges, 1390 of 1408 attempts in
+  // ARCSim's square.json), and the guard's answer could not change their outcome.
+  if (!collapse_edge_precheck(m_, e, remove_side)) {
+    report(kind, EditStage::kTopology, r);
+    return r;
+  }
   const int gone = m_.edges[e].n[remove_side], keep = m_.edges[e].n[1 - remove_side];
   const bool allowed = guard_allows_collapse(e, gone, keep);
   if (!allowed) ++counts_.guarded;

@@ -26,7 +26,9 @@
 //                  position: faces keep Fp, Sp and the edges their rest angles exactly as the edit copies them
 //                  (rebuilding them from an embedding would only add round-off), and the crack's lips stay where
 //                  the plastic shape holds them unless the reprojection finds a lower energy.
-// A refused edit stops at the stage that refused it (kGuardCheck or kTopology) and leaves the mesh untouched.
+// A refused edit stops at the stage that refused it (kGuardCheck or kTopology) and leaves the mesh untouched. A
+// collapse that flags and boundaries alone rule out (collapse_edge_precheck) is refused at kTopology, reported
+// alone, without a guard check.
 //
 // Follow-ups outside the mesh (node masses, the element cache and the solver's pattern, handle indices,
 // compaction) belong to the simulation: after a session's edits its client calls

@@ -315,15 +315,21 @@ EditResult flip_edge(Mesh& m, int edge) {
 // ------------------------------------------------------------------------------------------------------------
 // collapse_edge
 
+bool collapse_edge_precheck(const Mesh& m, int edge, int remove_side) {
+  if (!live_edge(m, edge) || (remove_side != 0 && remove_side != 1)) return false;
+  const Edge& e = m.edges[edge];
+  const int gone = e.n[remove_side];
+  if (e.preserve || m.nodes[gone].preserve) return false;
+  for (int ge : m.nodes[gone].edges)
+    if (m.edges[ge].preserve) return false;
+  return !(m.is_boundary_node(gone) && !e.is_boundary());
+}
+
 EditResult collapse_edge(Mesh& m, int edge, int remove_side) {
   EditResult r;
-  if (!live_edge(m, edge) || (remove_side != 0 && remove_side != 1)) return r;
+  if (!collapse_edge_precheck(m, edge, remove_side)) return r;
   const Edge& e = m.edges[edge];
   const int gone = e.n[remove_side], keep = e.n[1 - remove_side];
-  if (e.preserve || m.nodes[gone].preserve) return r;
-  for (int ge : m.nodes[gone].edges)
-    if (m.edges[ge].preserve) return r;
-  if (m.is_boundary_node(gone) && !e.is_boundary()) return r;
   NodeFan fan_gone, fan_keep;
   if (!node_fan(m, gone, fan_gone) || !node_fan(m, keep, fan_keep)) return r;
 

@@ -47,6 +47,10 @@ EditResult flip_edge(Mesh& mesh, int edge);
 // surviving face would become degenerate or inverted in rest space (normal turned by more than 60 degrees).
 // Surviving faces keep their state; edges whose wings change keep their plastic offset (see flip_edge).
 EditResult collapse_edge(Mesh& mesh, int edge, int remove_side);
+// The first of those rules, which read flags and boundaries only (a live edge, nothing preserved, a boundary
+// node removed only along a boundary edge): false means collapse_edge refuses the edit. For callers that would
+// otherwise pay for costlier checks (the edit session's world guard) before collapse_edge says no.
+bool collapse_edge_precheck(const Mesh& mesh, int edge, int remove_side);
 
 // Vertex split for a crack at `node` along 1 or 2 interior `cut_edges` incident to it. The cut edges (and, for a
 // boundary node, the boundary) divide the faces around the node into sectors; one sector stays with the node and

@@ -222,6 +222,33 @@ std::vector<std::string> documented(const std::string& kind) {
   return order;
 }
 
+// A collapse that flags and boundaries rule out (a boundary node along an interior edge) is refused at the
+// topology stage alone, before the world guard, exactly where the raw edit refuses it.
+TEST(EditSessionHooks, ACollapseRuledOutByTheBoundaryIsRefusedBeforeTheGuard) {
+  BentSheet s = make_plastically_bent_sheet(6, 4);
+  Mesh& m = s.mesh;
+  int edge = kNone, side = 0;
+  for (size_t e = 0; e < m.edges.size() && edge == kNone; ++e) {
+    if (m.edges[e].dead || m.edges[e].is_boundary()) continue;
+    for (int k = 0; k < 2 && edge == kNone; ++k)
+      if (m.is_boundary_node(m.edges[e].n[k]) && !m.nodes[m.edges[e].n[k]].preserve) edge = static_cast<int>(e), side = k;
+  }
+  ASSERT_NE(edge, kNone);
+  EXPECT_FALSE(collapse_edge_precheck(m, edge, side));
+  Mesh raw = m;
+  EXPECT_FALSE(collapse_edge(raw, edge, side).ok);
+
+  EditSession session(m, s.materials, EditSessionOptions());
+  StageRecorder recorder;
+  session.add_observer(&recorder);
+  const size_t faces = m.faces.size();
+  EXPECT_FALSE(session.collapse_edge(edge, side).ok);
+  EXPECT_EQ(recorder.stages, std::vector<std::string>{"collapse_edge:topology-"});
+  EXPECT_EQ(session.counts().guarded, 0);
+  EXPECT_EQ(m.faces.size(), faces);
+  EXPECT_FALSE(m.edges[edge].dead);
+}
+
 TEST(EditSessionHooks, RunInTheDocumentedOrderForEveryEdit) {
   BentSheet s = make_plastically_bent_sheet(6, 4);
   Mesh& m = s.mesh;
