@@ -427,11 +427,13 @@ StepWind step_wind(const ElementCache& cache, const std::vector<CompactWindForce
   out.quadratic.resize(wind.size());
   for (size_t e = 0; e < wind.size(); ++e) {
     const FaceElement& el = cache.faces[e];
-    const WindForce w = wind[e].expand();
-    Vec9 change;
-    for (int i = 0; i < 3; ++i) change.segment<3>(3 * i) = dv.segment<3>(3 * el.nodes[i]);
-    out.linear[e] = w.force.dot(change);
-    out.quadratic[e] = change.dot(w.jacobian * change);
+    Vec9 change, force;
+    for (int i = 0; i < 3; ++i) {
+      change.segment<3>(3 * i) = dv.segment<3>(3 * el.nodes[i]);
+      force.segment<3>(3 * i) = wind[e].node_force;
+    }
+    out.linear[e] = force.dot(change);
+    out.quadratic[e] = change.dot(wind[e].jacobian_times(change));
   }
   return out;
 }

@@ -33,6 +33,20 @@ struct CompactWindForce {
     }
     return w;
   }
+  // expand().jacobian * u, without the 9x9 matrix: the three block rows are equal, and each entry is the sum of
+  // its nine products taken in column order, as the matrix product sums it (the same bits; the step's energy
+  // check evaluates this for every face).
+  Vec9 jacobian_times(const Vec9& u) const {
+    Vec3 row_sums;
+    for (int p = 0; p < 3; ++p) {
+      double sum = 0;
+      for (int j = 0; j < 9; ++j) sum += block(p, j % 3) * u[j];
+      row_sums[p] = sum;
+    }
+    Vec9 out;
+    for (int a = 0; a < 3; ++a) out.segment<3>(3 * a) = row_sums;
+    return out;
+  }
 };
 
 // Force on the face (x0, x1, x2) (m) with node velocities v0, v1, v2 (m/s). The Jacobian is with respect to

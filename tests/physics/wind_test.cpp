@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "support/eigenvalues.hpp"
@@ -96,6 +97,22 @@ TEST(Wind, CompactFormExpandsToTheSameForce) {
       EXPECT_EQ(back.force[i], w.force[i]) << "trial " << trial;
       for (int j = 0; j < 9; ++j) EXPECT_EQ(back.jacobian(i, j), w.jacobian(i, j)) << "trial " << trial;
     }
+  }
+}
+
+// The energy check multiplies the Jacobian without expanding it: the same bits as the 9x9 product.
+TEST(Wind, CompactJacobianProductIsTheExpandedOne) {
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  auto rvec = [&] { return Vec3(uni(gen), uni(gen), uni(gen)); };
+  for (int trial = 0; trial < 200; ++trial) {
+    const WindForce w = wind_force(rvec(), rvec(), rvec(), rvec(), rvec(), rvec(), 3 * rvec(), 1 + uni(gen), 1 + uni(gen));
+    const CompactWindForce c = CompactWindForce::of(w);
+    Vec9 u;
+    for (int i = 0; i < 9; ++i) u[i] = std::ldexp(uni(gen), static_cast<int>(gen() % 40) - 20);
+    const Vec9 expected = w.jacobian * u, got = c.jacobian_times(u);
+    for (int i = 0; i < 9; ++i) EXPECT_EQ(got[i], expected[i]) << "trial " << trial << " row " << i;
+    EXPECT_EQ(u.dot(got), u.dot(w.jacobian * u)) << "trial " << trial;
   }
 }
 
