@@ -4,6 +4,7 @@
 #include <chrono>
 #include <iterator>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "io/errors.hpp"
@@ -42,6 +43,28 @@ void rebuild_pattern(ElementCache& cache) {
 }
 
 }  // namespace
+
+const Vec3* BendingAngleMemo::find(size_t k, const std::array<Vec3, 6>& corners,
+                                   const std::array<bool, 3>& has_wing) const {
+  if (k >= entries_.size()) return nullptr;
+  const Entry& e = entries_[k];
+  if (!e.set || e.has_wing != has_wing) return nullptr;
+  // Bits, not values: corners equal as numbers (+0 and -0) may still give different angles.
+  return std::memcmp(e.corners.data(), corners.data(), sizeof(corners)) == 0 ? &e.theta : nullptr;
+}
+
+void BendingAngleMemo::reserve(size_t count) {
+  if (entries_.size() < count) entries_.resize(count);
+}
+
+void BendingAngleMemo::store(size_t k, const std::array<Vec3, 6>& corners, const std::array<bool, 3>& has_wing,
+                             const Vec3& theta) {
+  Entry& e = entries_[k];
+  e.corners = corners;
+  e.has_wing = has_wing;
+  e.theta = theta;
+  e.set = true;
+}
 
 void update_node_masses(Mesh& mesh, const std::vector<Material>& materials) {
   for (Node& n : mesh.nodes) n.mass = 0;
@@ -140,11 +163,13 @@ std::array<Vec3, 6> gather_positions(const Mesh& mesh, const std::array<int, 6>&
 }
 
 // The elastic energy (J) of the cache's elements with node n at x[n]. Elements are evaluated in parallel and
-// summed in element order, so the sum is the same with or without threads.
-double internal_energy_at(const std::vector<Vec3>& x, const ElementCache& cache) {
+// summed in element order, so the sum is the same with or without threads. `angles`, if given, keeps the
+// bending elements' angles at these positions.
+double internal_energy_at(const std::vector<Vec3>& x, const ElementCache& cache, BendingAngleMemo* angles = nullptr) {
   const int faces = static_cast<int>(cache.faces.size());
   const int count = faces + static_cast<int>(cache.bending.size());
   std::vector<double> energy(count);
+  if (angles) angles->reserve(cache.bending.size());
 #pragma omp parallel for schedule(static) if (count > 4096)
   for (int k = 0; k < count; ++k) {
     if (k < faces) {
@@ -154,7 +179,9 @@ double internal_energy_at(const std::vector<Vec3>& x, const ElementCache& cache)
       const BendingElement& b = cache.bending[k - faces];
       std::array<Vec3, 6> corners;
       for (int i = 0; i < 6; ++i) corners[i] = x[b.nodes[i]];
-      energy[k] = plate_bending_energy(corners, b.has_wing, b.rest_theta, b.Q);
+      Vec3 theta;
+      energy[k] = plate_bending_energy(corners, b.has_wing, b.rest_theta, b.Q, angles ? &theta : nullptr);
+      if (angles) angles->store(k - faces, corners, b.has_wing, theta);
     }
   }
   double sum = 0;
@@ -298,7 +325,7 @@ double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements,
 
 double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& faces,
                               const std::vector<BendingElement>& bending, const InternalAssembly& how,
-                              BlockSystem& system) {
+                              BlockSystem& system, const BendingAngleMemo* angles) {
   double energy = assemble_elements<3, MembraneTerms>(
       mesh, faces, how,
       [&](const FaceElement& el, MembraneTerms& t) {
@@ -309,8 +336,9 @@ double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& 
   energy += assemble_elements<6, PlateBendingTerms>(
       mesh, bending, how,
       [&](const BendingElement& el, PlateBendingTerms& t) {
-        plate_bending_terms(gather_positions(mesh, el.nodes), el.has_wing, el.rest_theta, el.Q,
-                            HessianKind::kProjected, t);
+        const std::array<Vec3, 6> x = gather_positions(mesh, el.nodes);
+        const Vec3* theta = angles ? angles->find(static_cast<size_t>(&el - bending.data()), x, el.has_wing) : nullptr;
+        plate_bending_terms(x, el.has_wing, el.rest_theta, el.Q, HessianKind::kProjected, t, theta);
       },
       system);
   return energy;
@@ -324,7 +352,8 @@ double assemble_internal(const Mesh& mesh, const ElementCache& cache, const Inte
 void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& faces,
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
                              const ExternalLoads& loads, double dt, BlockSystem& system,
-                             Linearisation linearisation, std::vector<CompactWindForce>* wind) {
+                             Linearisation linearisation, std::vector<CompactWindForce>* wind,
+                             const BendingAngleMemo* angles) {
   // Backward Euler linearised once (ARCSim): with H the PSD stiffness, beta the damping coefficient,
   //   (M + dt (dt + beta) H - dt D_v) dv = dt [ f - (dt + beta) H v + f_ext ]
   // where D_v is the velocity Jacobian of air drag. Units: blocks in kg, rhs in N s.
@@ -335,7 +364,7 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
   const bool newton = linearisation == Linearisation::kNewtonFromRest;
   how.velocity_scale = newton ? 0 : dt * dt;
   how.damping_velocity_scale = dt;
-  assemble_element_terms(mesh, faces, bending, how, system);
+  assemble_element_terms(mesh, faces, bending, how, system, angles);
 
   for (int d = 0; d < dofs.count(); ++d) {
     const Node& node = mesh.nodes[dofs.node(d)];
@@ -439,7 +468,8 @@ StepWind step_wind(const ElementCache& cache, const std::vector<CompactWindForce
 }
 
 double step_potential(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads, double dt,
-                      const StepWind& wind, const VecX& dv, double alpha, double* magnitude = nullptr) {
+                      const StepWind& wind, const VecX& dv, double alpha, BendingAngleMemo* angles,
+                      double* magnitude = nullptr) {
   const int n = static_cast<int>(mesh.nodes.size());
   std::vector<Vec3> v(n), x(n);
   double potential = 0, signed_terms = 0;  // signed_terms: gravity and wind
@@ -451,7 +481,7 @@ double step_potential(const Mesh& mesh, const ElementCache& cache, const Externa
     potential += 0.5 * node.mass * change.squaredNorm();
     signed_terms -= dt * node.mass * loads.gravity.dot(v[i]);
   }
-  potential += internal_energy_at(x, cache);
+  potential += internal_energy_at(x, cache, angles);
   for (const HandleSpring& s : loads.springs) potential += 0.5 * s.stiffness * (x[s.node] - s.target).squaredNorm();
   for (const ContactTerm& c : loads.contacts) {
     Vec3 u = c.outside_velocity;
@@ -485,15 +515,17 @@ double step_potential(const Mesh& mesh, const ElementCache& cache, const Externa
 // couples to their in-plane stretch by the sine of the fold, so the solve relieved a neighbour's stretch by
 // swinging it out of the plane by 1/sin(fold) as far (1 cm on 1 cm edges in tests/stress/foil_crumple_test.cpp's
 // case at 50 steps a frame: 55 J of elastic energy from one step, released as plastic work).
+// `angles` keeps the bending angles of the last potential evaluated: at the positions the step takes.
 double step_fraction(const Mesh& mesh, const ElementCache& cache, const ExternalLoads& loads, double dt,
-                     const std::vector<CompactWindForce>& air, const VecX& dv, double predicted) {
+                     const std::vector<CompactWindForce>& air, const VecX& dv, double predicted,
+                     BendingAngleMemo* angles) {
   const StepWind wind = step_wind(cache, air, dv);
   double magnitude = 0;
-  const double start = step_potential(mesh, cache, loads, dt, wind, dv, 0, &magnitude);
+  const double start = step_potential(mesh, cache, loads, dt, wind, dv, 0, angles, &magnitude);
   // Rounding of the sums (~1e-16 of each term) must not shorten a step.
   const double allowed = std::max(predicted, 0.0) + 1e-9 * magnitude;
   auto lowers = [&](double from, double value) { return value <= from + allowed; };
-  if (lowers(start, step_potential(mesh, cache, loads, dt, wind, dv, 1))) return 1;  // the usual case
+  if (lowers(start, step_potential(mesh, cache, loads, dt, wind, dv, 1, angles))) return 1;  // the usual case
   // Only now the damping potential dt/2 v^T B v, B = sum of beta_e H_e at x_n as the system has it: a
   // damped step may raise the rest of the potential by less than it lowers this part.
   BlockSystem damping;
@@ -513,7 +545,7 @@ double step_fraction(const Mesh& mesh, const ElementCache& cache, const External
   const double full_start = start + damping_potential(0);
   double alpha = 1;
   for (int k = 0; k <= kMaxHalvings; ++k) {
-    if (lowers(full_start, step_potential(mesh, cache, loads, dt, wind, dv, alpha) + damping_potential(alpha)))
+    if (lowers(full_start, step_potential(mesh, cache, loads, dt, wind, dv, alpha, angles) + damping_potential(alpha)))
       return alpha;
     alpha *= 0.5;
   }
@@ -534,7 +566,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
   system.reset(cache.pattern);
   std::vector<CompactWindForce> wind;
   assemble_implicit_euler(mesh, cache.faces, cache.bending, SystemDofs::all_nodes(n), loads, dt, system,
-                          Linearisation::kStep, &wind);
+                          Linearisation::kStep, &wind, &cache.angles);
   if (!loads.pinned.empty()) {
     // Dirichlet: zero the pinned rows and columns, unit diagonal, zero right-hand side (dv = 0).
     for (int k = 0; k < cache.pattern.block_count(); ++k) {
@@ -553,7 +585,7 @@ void implicit_euler_step(Mesh& mesh, ElementCache& cache, CholeskySolver& solver
                                      solver.failed_row());
   });
   // The linear model's decrease of the potential: b.dv - dv.A dv / 2 = b.dv / 2 (A dv = b).
-  const double alpha = step_fraction(mesh, cache, loads, dt, wind, dv, 0.5 * system.rhs.dot(dv));
+  const double alpha = step_fraction(mesh, cache, loads, dt, wind, dv, 0.5 * system.rhs.dot(dv), &cache.angles);
   for (int i = 0; i < n; ++i) {
     Node& node = mesh.nodes[i];
     const Vec3 change = alpha * dv.segment<3>(3 * i);

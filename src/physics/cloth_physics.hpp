@@ -21,6 +21,27 @@ namespace arcsim {
 
 // Per-topology data of the physics: element node lists, element data (physics/face_element.hpp) and block ids.
 // Rebuilt whenever the mesh topology or rest state changes (after remeshing, fracture or plastic updates).
+// The world dihedral angles of bending elements, each with the corners it was computed at: the step's energy
+// check evaluates every element at the positions the step then takes, and the next assembly finds the angles
+// there again (bit for bit the same corners: the same angles) instead of recomputing them.
+class BendingAngleMemo {
+ public:
+  // Element k's angles if they were last computed at exactly these corners (bits) and wings; nullptr otherwise.
+  const Vec3* find(size_t k, const std::array<Vec3, 6>& corners, const std::array<bool, 3>& has_wing) const;
+  // Room for `count` elements (before store is called from parallel loops).
+  void reserve(size_t count);
+  void store(size_t k, const std::array<Vec3, 6>& corners, const std::array<bool, 3>& has_wing, const Vec3& theta);
+
+ private:
+  struct Entry {
+    std::array<Vec3, 6> corners;
+    std::array<bool, 3> has_wing{false, false, false};
+    Vec3 theta = Vec3::Zero();
+    bool set = false;
+  };
+  std::vector<Entry> entries_;
+};
+
 struct ElementCache {
   using FaceElement = arcsim::FaceElement;
   using BendingElement = arcsim::BendingElement;
@@ -32,6 +53,7 @@ struct ElementCache {
   std::vector<std::pair<int, int>> element_pairs;  // (row >= col), sorted, unique
   std::vector<std::pair<int, int>> contact_pairs;  // extra pairs not among element_pairs, sorted, unique
   bool pattern_stale = false;  // element pairs changed since the pattern was built (PatternBuild::kDeferred)
+  BendingAngleMemo angles;     // of `bending`, from the last energy check (implicit_euler_step)
 };
 
 // A contact (proximity) term over up to four nodes, linearised for the implicit step. The gap
@@ -90,9 +112,10 @@ struct InternalAssembly {
 double assemble_internal(const Mesh& mesh, const ElementCache& cache, const InternalAssembly& how,
                          BlockSystem& system);
 // The same over any element lists (a zone's): rows and blocks from the elements' dofs and block ids.
+// `angles`, if given, holds angles of `bending` already computed (BendingAngleMemo).
 double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& faces,
                               const std::vector<BendingElement>& bending, const InternalAssembly& how,
-                              BlockSystem& system);
+                              BlockSystem& system, const BendingAngleMemo* angles = nullptr);
 
 // External loads of one step.
 struct HandleSpring {
@@ -139,7 +162,8 @@ void assemble_implicit_euler(const Mesh& mesh, const std::vector<FaceElement>& f
                              const std::vector<BendingElement>& bending, const SystemDofs& dofs,
                              const ExternalLoads& loads, double dt, BlockSystem& system,
                              Linearisation linearisation = Linearisation::kStep,
-                             std::vector<CompactWindForce>* wind = nullptr);
+                             std::vector<CompactWindForce>* wind = nullptr,
+                             const BendingAngleMemo* angles = nullptr);
 
 // Solves the assembled system for dv (CholeskySolver::solve_system: factorised, or by conjugate gradients with a
 // kept factorisation for large systems), adding the wall times and the solve's report to `timing`. Throws NumericalError, its message starting with `step` ("implicit step", "zone step"), if the

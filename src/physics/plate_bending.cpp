@@ -26,12 +26,15 @@ double hinge_angle_deviation(const Vec3& x0, const Vec3& x1, const Vec3& x2, con
 }
 
 double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
-                            const Vec3& rest_theta, const Mat3& Q) {
+                            const Vec3& rest_theta, const Mat3& Q, Vec3* theta) {
   Vec3 delta = Vec3::Zero();
+  if (theta) theta->setZero();
   for (int i = 0; i < 3; ++i) {
     if (!has_wing[i]) continue;
     const auto s = plate_hinge_slots(i);
-    delta[i] = hinge_angle_deviation(x[s[0]], x[s[1]], x[s[2]], x[s[3]], rest_theta[i]);
+    const double angle = dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
+    if (theta) (*theta)[i] = angle;
+    delta[i] = wrap_angle(angle - rest_theta[i]);  // hinge_angle_deviation, with the angle kept
   }
   return delta.dot(Q * delta);
 }
@@ -44,7 +47,7 @@ PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::a
 }
 
 void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing, const Vec3& rest_theta,
-                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out) {
+                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out, const Vec3* known_theta) {
   out.gradient.setZero();
   out.theta.setZero();
   std::array<Vec12, 3> grad;
@@ -53,7 +56,7 @@ void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>
     grad[i].setZero();
     if (!has_wing[i]) continue;
     const auto s = plate_hinge_slots(i);
-    out.theta[i] = dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
+    out.theta[i] = known_theta ? (*known_theta)[i] : dihedral_angle(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
     delta[i] = wrap_angle(out.theta[i] - rest_theta[i]);  // hinge_angle_deviation, with the angle kept
     grad[i] = dihedral_angle_gradient(x[s[0]], x[s[1]], x[s[2]], x[s[3]]);
   }

@@ -55,13 +55,15 @@ struct PlateBendingTerms {
 PlateBendingTerms plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
                                       const Vec3& rest_theta, const Mat3& Q, HessianKind hessian);
 // The same, written over `out` (every field): the assembly evaluates into its own buffer, with no copy of the
-// 18x18 Hessian.
+// 18x18 Hessian. `known_theta`, if given, is out.theta as computed before at these very positions.
 void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing, const Vec3& rest_theta,
-                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out);
+                         const Mat3& Q, HessianKind hessian, PlateBendingTerms& out,
+                         const Vec3* known_theta = nullptr);
 
 // The energy alone (J), equal to plate_bending_terms(...).energy, without the angles' gradients (for energy
 // checks that evaluate every element several times per step).
+// `theta`, if given, gets the world dihedral angles as plate_bending_terms gives them (0 where no wing).
 double plate_bending_energy(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
-                            const Vec3& rest_theta, const Mat3& Q);
+                            const Vec3& rest_theta, const Mat3& Q, Vec3* theta = nullptr);
 
 }  // namespace arcsim

@@ -7,6 +7,7 @@
 
 #include "physics/cloth_physics.hpp"
 #include "physics/membrane.hpp"
+#include "physics/plate_bending.hpp"
 #include "support/mesh_factory.hpp"
 
 namespace arcsim {
@@ -294,6 +295,56 @@ TEST(ImplicitEuler, AssemblyReportsTheFacesWindForces) {
   assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, SystemDofs::all_nodes(n), loads, 0.01, system,
                           Linearisation::kStep, &wind);
   EXPECT_TRUE(wind.empty());
+}
+
+// The step keeps the bending angles its energy check computed at the positions it then takes, and the next
+// assembly reuses them: that must give the assembly it gives without them, bit for bit, and only at exactly
+// the positions they were computed at.
+TEST(ImplicitEuler, KeptBendingAnglesGiveTheSameAssembly) {
+  Sheet s(testing::make_grid(5, 4, 0.3, 0.2, testing::Diagonal::kAlternating));
+  for (size_t i = 0; i < s.mesh.nodes.size(); ++i) {
+    Node& node = s.mesh.nodes[i];
+    node.x.z() = 0.02 * std::sin(7.0 * node.x.x()) * std::cos(5.0 * node.x.y());
+    node.v = Vec3(0.01 * i, -0.02, 0.03);
+  }
+  // Angles at the current positions, as the energy check keeps them; one element's at slightly other ones.
+  BendingAngleMemo memo;
+  memo.reserve(s.cache.bending.size());
+  std::array<Vec3, 6> moved_corners{};
+  for (size_t k = 0; k < s.cache.bending.size(); ++k) {
+    const BendingElement& b = s.cache.bending[k];
+    std::array<Vec3, 6> x;
+    for (int i = 0; i < 6; ++i) x[i] = s.mesh.nodes[b.nodes[i]].x;
+    Vec3 theta;
+    plate_bending_energy(x, b.has_wing, b.rest_theta, b.Q, &theta);
+    EXPECT_TRUE(theta == plate_bending_terms(x, b.has_wing, b.rest_theta, b.Q, HessianKind::kNone).theta);
+    if (k == 3) {
+      moved_corners = x;
+      moved_corners[0].x() = std::nextafter(x[0].x(), 1.0);
+      plate_bending_energy(moved_corners, b.has_wing, b.rest_theta, b.Q, &theta);
+      memo.store(k, moved_corners, b.has_wing, theta);
+      EXPECT_EQ(memo.find(k, x, b.has_wing), nullptr);
+    } else {
+      memo.store(k, x, b.has_wing, theta);
+      EXPECT_NE(memo.find(k, x, b.has_wing), nullptr);
+    }
+  }
+  const int n = static_cast<int>(s.mesh.nodes.size());
+  BlockSystem with, without;
+  with.reset(s.cache.pattern);
+  without.reset(s.cache.pattern);
+  assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, SystemDofs::all_nodes(n), ExternalLoads(), 0.01,
+                          with, Linearisation::kStep, nullptr, &memo);
+  assemble_implicit_euler(s.mesh, s.cache.faces, s.cache.bending, SystemDofs::all_nodes(n), ExternalLoads(), 0.01,
+                          without);
+  EXPECT_TRUE(with.rhs == without.rhs);
+  for (size_t k = 0; k < with.blocks.size(); ++k) EXPECT_TRUE(with.blocks[k] == without.blocks[k]) << "block " << k;
+  // A signed zero is another corner: the angle may differ, so it is not reused.
+  std::array<Vec3, 6> zero_corners = moved_corners;
+  zero_corners[1].z() = 0.0;
+  memo.store(0, zero_corners, s.cache.bending[0].has_wing, Vec3::Zero());
+  zero_corners[1].z() = -0.0;
+  EXPECT_EQ(memo.find(0, zero_corners, s.cache.bending[0].has_wing), nullptr);
 }
 
 }  // namespace
