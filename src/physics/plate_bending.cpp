@@ -5,6 +5,39 @@
 
 namespace arcsim {
 
+namespace {
+
+// The 3x3 products of the bending Hessian in which one factor has a single nonzero column (a wing slot's G):
+// each entry is then one product plus two exact zeros. A nonzero product absorbs the zeros exactly, and a sum of
+// zeros does not depend on its order, so these give the very bits Eigen's general 3x3 product gives, whatever
+// order it sums in; the zeros are formed (as Eigen forms them) only where the product is itself zero.
+
+// Entries where the single product is zero get the sum of all three terms (zeros), in any order.
+template <typename Term>
+void resum_zero_entries(Mat3& out, Term term) {
+  if (!(out.array() == 0).any()) return;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (out(r, c) == 0) out(r, c) = term(r, 0, c) + term(r, 1, c) + term(r, 2, c);
+}
+
+// 2 G Q, G zero outside column `col`: the outer product of 2 G's column and Q's row.
+Mat3 twice_single_column_times(const Mat3& G, int col, const Mat3& Q) {
+  const Vec3 a = 2 * G.col(col);
+  Mat3 out = a * Q.row(col);
+  resum_zero_entries(out, [&](int r, int k, int c) { return (2 * G(r, k)) * Q(k, c); });
+  return out;
+}
+
+// A G^T, G zero outside column `col`: the outer product of A's and G's columns.
+Mat3 times_single_column_transpose(const Mat3& A, const Mat3& G, int col) {
+  Mat3 out = A.col(col) * G.col(col).transpose();
+  resum_zero_entries(out, [&](int r, int k, int c) { return A(r, k) * G(c, k); });
+  return out;
+}
+
+}  // namespace
+
 Mat3 plate_bending_matrix(const std::array<double, 3>& lengths, const std::array<Vec3, 3>& normals, double area,
                           double kb, double nu, const std::array<bool, 3>& has_edge) {
   Mat3 Q = Mat3::Zero();
@@ -81,13 +114,16 @@ void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>
     const auto s = plate_hinge_slots(i);
     for (int a = 0; a < 4; ++a) G[s[a]].col(i) = grad[i].segment<3>(3 * a);
   }
+  // A wing slot p = 3 + i lies in hinge i only: G_p's one nonzero column is i.
   std::array<Mat3, 6> GQ;
-  for (int p = 0; p < 6; ++p) GQ[p] = 2 * G[p] * Q;
+  for (int p = 0; p < 3; ++p) GQ[p] = 2 * G[p] * Q;
+  for (int p = 3; p < 6; ++p)
+    if (has_wing[p - 3]) GQ[p] = twice_single_column_times(G[p], p - 3, Q);
   for (int p = 0; p < 6; ++p) {
     if (p >= 3 && !has_wing[p - 3]) continue;
     for (int q = p; q < 6; ++q) {
       if (q >= 3 && !has_wing[q - 3]) continue;
-      const Mat3 block = GQ[p] * G[q].transpose();
+      const Mat3 block = q < 3 ? Mat3(GQ[p] * G[q].transpose()) : times_single_column_transpose(GQ[p], G[q], q - 3);
       out.hessian.block<3, 3>(3 * p, 3 * q) = block;
       if (q != p) out.hessian.block<3, 3>(3 * q, 3 * p) = block.transpose();
     }
