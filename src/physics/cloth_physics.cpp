@@ -521,7 +521,8 @@ double step_fraction(const Mesh& mesh, const ElementCache& cache, const External
                      BendingAngleMemo* angles) {
   const StepWind wind = step_wind(cache, air, dv);
   double magnitude = 0;
-  const double start = step_potential(mesh, cache, loads, dt, wind, dv, 0, angles, &magnitude);
+  // alpha = 0 is never the step taken: its angles are not kept.
+  const double start = step_potential(mesh, cache, loads, dt, wind, dv, 0, nullptr, &magnitude);
   // Rounding of the sums (~1e-16 of each term) must not shorten a step.
   const double allowed = std::max(predicted, 0.0) + 1e-9 * magnitude;
   auto lowers = [&](double from, double value) { return value <= from + allowed; };
