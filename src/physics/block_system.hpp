@@ -3,7 +3,8 @@
 // The sparsity pattern depends only on which node pairs interact (faces, hinges, and any extra pairs such as
 // contacts), so it is built once per topology and its CHOLMOD symbolic analysis is reused until it changes.
 // Element matrices are accumulated into 3x3 blocks in a fixed order (deterministic whatever the thread count),
-// then copied into the upper triangle of a compressed-column matrix that CHOLMOD factorises.
+// then copied, through a map fixed per analysis, into the lower triangle of the permuted matrix P A P' that
+// CHOLMOD's supernodal phase factorises (CholeskySolver).
 #pragma once
 
 #include <array>
