@@ -256,14 +256,7 @@ bool inside(const Aabb& box, const Aabb& bound) {
 bool list_fits(const CandidateList& list, const ContactGeometry& g, const CandidateOptions& options,
                const std::vector<Aabb>& node_boxes) {
   if (!list.ready || list.margin != options.margin || list.vertex_edge != options.vertex_edge ||
-      list.meshes.size() != g.meshes.size() || list.grown.size() != node_boxes.size())
-    return false;
-  for (size_t m = 0; m < g.meshes.size(); ++m)
-    if (!same_range(list.meshes[m], g.meshes[m])) return false;
-  if (!same_values(list.faces, g.faces) || !same_values(list.edges, g.edges) ||
-      !same_values(list.edge_faces, g.edge_faces) || !same_values(list.owned_node_begin, g.owned_node_begin) ||
-      !same_values(list.owned_nodes, g.owned_nodes) || !same_values(list.owned_edge_begin, g.owned_edge_begin) ||
-      !same_values(list.owned_edges, g.owned_edges))
+      list.grown.size() != node_boxes.size() || !list.connectivity.matches(g))
     return false;
   for (size_t n = 0; n < node_boxes.size(); ++n)
     if (!inside(node_boxes[n], list.grown[n])) return false;
@@ -314,14 +307,7 @@ void make_list(const ContactGeometry& g, BvhCache& cache, const CandidateOptions
     for (int kind = 0; kind < 3; ++kind)
       list.by_kind[kind].insert(list.by_kind[kind].end(), local[kind].begin(), local[kind].end());
   }
-  list.meshes = g.meshes;
-  list.faces = g.faces;
-  list.edges = g.edges;
-  list.edge_faces = g.edge_faces;
-  list.owned_node_begin = g.owned_node_begin;
-  list.owned_nodes = g.owned_nodes;
-  list.owned_edge_begin = g.owned_edge_begin;
-  list.owned_edges = g.owned_edges;
+  list.connectivity.capture(g);
   list.margin = options.margin;
   list.vertex_edge = options.vertex_edge;
   list.ready = true;
@@ -397,6 +383,26 @@ std::vector<PrimitivePair> search_directly(const ContactGeometry& g, BvhCache& c
 }
 
 }  // namespace
+
+void CandidateConnectivity::capture(const ContactGeometry& g) {
+  meshes = g.meshes;
+  faces = g.faces;
+  edges = g.edges;
+  edge_faces = g.edge_faces;
+  owned_node_begin = g.owned_node_begin;
+  owned_nodes = g.owned_nodes;
+  owned_edge_begin = g.owned_edge_begin;
+  owned_edges = g.owned_edges;
+}
+
+bool CandidateConnectivity::matches(const ContactGeometry& g) const {
+  if (meshes.size() != g.meshes.size()) return false;
+  for (size_t m = 0; m < g.meshes.size(); ++m)
+    if (!same_range(meshes[m], g.meshes[m])) return false;
+  return same_values(faces, g.faces) && same_values(edges, g.edges) && same_values(edge_faces, g.edge_faces) &&
+         same_values(owned_node_begin, g.owned_node_begin) && same_values(owned_nodes, g.owned_nodes) &&
+         same_values(owned_edge_begin, g.owned_edge_begin) && same_values(owned_edges, g.owned_edges);
+}
 
 std::vector<PrimitivePair> find_candidates(const ContactGeometry& g, BvhCache& cache,
                                            const CandidateOptions& options) {

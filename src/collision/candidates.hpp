@@ -33,13 +33,22 @@ std::array<int, 4> pair_nodes(const ContactGeometry& g, const PrimitivePair& p);
 // whose boxes overlap then is on the list, so a search only filters the list by boxes and moved flags. WHY:
 // a sheet's nodes move little from one step to the next, and on small sheets finding the face pairs again
 // (a traversal that reports every neighbouring face) cost more than all the tests they lead to.
-struct CandidateList {
-  bool ready = false;
-  // What the list was made for: the geometry's connectivity and the search's options.
+// The parts of a ContactGeometry a candidate list depends on besides positions: kept with the list, and compared
+// with the geometry of each later search (all of it, bit for bit: the meshes' topology hashes could collide).
+struct CandidateConnectivity {
   std::vector<ContactGeometry::Range> meshes;
   std::vector<std::array<int, 3>> faces;
   std::vector<std::array<int, 2>> edges, edge_faces;
   std::vector<int> owned_node_begin, owned_nodes, owned_edge_begin, owned_edges;
+
+  void capture(const ContactGeometry& g);
+  bool matches(const ContactGeometry& g) const;
+};
+
+struct CandidateList {
+  bool ready = false;
+  // What the list was made for: the geometry's connectivity and the search's options.
+  CandidateConnectivity connectivity;
   double margin = 0;
   bool vertex_edge = false;
   std::vector<Aabb> grown;  // per node: the box its search box must stay inside
