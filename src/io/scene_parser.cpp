@@ -518,6 +518,7 @@ class SceneParser {
     s.pcg_min_nodes = get_int(r.get("pcg_min_nodes"), s.pcg_min_nodes, 0);
     s.pcg_tolerance = get_real(r.get("pcg_tolerance"), s.pcg_tolerance, Limits{0, 1, true, true});
     s.pcg_max_iterations = get_int(r.get("pcg_max_iterations"), s.pcg_max_iterations, 1, 1000);
+    s.block_max_nodes = get_int(r.get("block_max_nodes"), s.block_max_nodes, 0);
     r.warn_unknown();
   }
 

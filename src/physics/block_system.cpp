@@ -186,6 +186,7 @@ CholeskySolver::CholeskySolver(CholeskySolver&& other) noexcept { *this = std::m
 
 CholeskySolver& CholeskySolver::operator=(CholeskySolver&& other) noexcept {
   llt_ = std::move(other.llt_);
+  block_ = std::move(other.block_);
   matrix_.swap(other.matrix_);
   lower_start_.swap(other.lower_start_);
   lower_row_.swap(other.lower_row_);
@@ -203,8 +204,21 @@ CholeskySolver& CholeskySolver::operator=(CholeskySolver&& other) noexcept {
 
 bool CholeskySolver::factorize(const BlockSystem& system) {
   const uint64_t id = system.pattern->id();
+  if (system.pattern->node_count() <= settings_.block_max_nodes) {
+    if (!block_ || analysed_pattern_ != id) {
+      llt_.reset();
+      block_ = std::make_unique<BlockCholesky>();
+      block_->analyse(*system.pattern);
+      analysed_pattern_ = id;
+      ++analyses_;
+    }
+    ++factorizations_;
+    factor_current_ = block_->factorize(system);
+    return factor_current_;
+  }
   system.pattern->prepare_layout();
   if (!llt_ || analysed_pattern_ != id) {
+    block_.reset();
     matrix_ = system.pattern->csc_structure();
     system.to_csc(matrix_);
     llt_ = std::make_unique<SupernodalLLT>();
@@ -291,7 +305,7 @@ bool CholeskySolver::factorize_matrix(const BlockSystem& system) {
   return factor_current_;
 }
 
-VecX CholeskySolver::solve(const VecX& rhs) { return llt_->solve(rhs); }
+VecX CholeskySolver::solve(const VecX& rhs) { return block_ ? block_->solve(rhs) : VecX(llt_->solve(rhs)); }
 
 bool CholeskySolver::conjugate_gradients(const BlockSystem& system, VecX& x, int& iterations) {
   // Preconditioned conjugate gradients (the textbook recurrence), x_0 = 0, so that its first iterate is the
@@ -329,7 +343,8 @@ bool CholeskySolver::solve_system(const BlockSystem& system, VecX& x, SolveRepor
   // Any definite preconditioner of the right size serves, whatever its pattern: a kept factorisation also serves
   // after contacts came or went (flag.json changes its pattern every third step so), the iteration deciding
   // whether it is still close enough.
-  if (iterative && factor_current_ && llt_ && llt_->rows() == system.rhs.size())
+  const long factor_rows = block_ ? 3L * block_->node_count() : llt_ ? static_cast<long>(llt_->rows()) : -1;
+  if (iterative && factor_current_ && factor_rows == system.rhs.size())
     solved = conjugate_gradients(system, x, report.iterations);
   if (!solved) {
     const auto t1 = std::chrono::steady_clock::now();

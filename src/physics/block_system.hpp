@@ -17,6 +17,7 @@
 #include <Eigen/Sparse>
 
 #include "math/types.hpp"
+#include "physics/block_cholesky.hpp"
 #include "physics/solver_settings.hpp"
 
 namespace arcsim {
@@ -136,8 +137,9 @@ struct SolveReport {
   double factor_seconds = 0, solve_seconds = 0;  // wall: the factorisation (and analysis); the rest
 };
 
-// Sparse Cholesky (CHOLMOD, supernodal, AMD ordering) of a BlockSystem, reusing the symbolic analysis while the
-// pattern id is unchanged, and for large systems the numeric factorisation too (SolverSettings).
+// Sparse Cholesky of a BlockSystem (AMD ordering): BlockCholesky up to SolverSettings::block_max_nodes nodes,
+// CHOLMOD's supernodal factorisation above. Reuses the symbolic analysis while the pattern id is unchanged, and
+// for large systems the numeric factorisation too (SolverSettings).
 class CholeskySolver {
  public:
   CholeskySolver();
@@ -163,7 +165,9 @@ class CholeskySolver {
   int factorizations() const { return factorizations_; }
   // After a failed factorisation: the matrix row where CHOLMOD met a non-positive pivot (row / 3 is the
   // system's dof); -1 otherwise.
-  int failed_row() const { return llt_ ? llt_->failed_row() : -1; }
+  int failed_row() const { return block_ ? block_->failed_row() : llt_ ? llt_->failed_row() : -1; }
+  // Whether the last analysis chose the node-block factorisation (small systems) rather than CHOLMOD's.
+  bool uses_block_factorization() const { return block_ != nullptr; }
 
  private:
   // Lays out tril(P A P') for the pattern just analysed and where each entry of A's upper triangle goes in it.
@@ -174,7 +178,9 @@ class CholeskySolver {
   // reach the tolerance (or met non-positive curvature).
   bool conjugate_gradients(const BlockSystem& system, VecX& x, int& iterations);
 
+  // Exactly one of the two holds the analysis of analysed_pattern_ (none before the first factorisation).
   std::unique_ptr<SupernodalLLT> llt_;
+  std::unique_ptr<BlockCholesky> block_;
   Eigen::SparseMatrix<double> matrix_;
   // tril(P A P') in compressed columns, refilled at every factorisation through lower_place_ (indexed like the
   // values of matrix_). WHY: CHOLMOD otherwise transposes the whole matrix into this form at every call, a
@@ -182,7 +188,7 @@ class CholeskySolver {
   std::vector<int> lower_start_, lower_row_, lower_place_;
   std::vector<double> lower_value_;
   uint64_t analysed_pattern_ = 0;
-  bool factor_current_ = false;  // llt_ holds a factorisation of a matrix on analysed_pattern_
+  bool factor_current_ = false;  // llt_ or block_ holds a factorisation of a matrix on analysed_pattern_
   SolverSettings settings_;
   int analyses_ = 0;
   int factorizations_ = 0;

@@ -15,6 +15,10 @@ namespace arcsim {
 // factorisation left a relative residual of 1e-3..4e-2 after 20 iterations (the clamped membrane geometric
 // stiffness switches between steps), so every step paid the iterations and then the factorisation.
 struct SolverSettings {
+  // Systems of at most this many nodes are factorised by BlockCholesky (3x3 node blocks, no per-supernode
+  // overhead), larger ones by CHOLMOD's supernodal factorisation, which wins once its supernodes are wide
+  // (docs/benchmarks.md, "Small systems' factorisation").
+  int block_max_nodes = 300;
   int pcg_min_nodes = 2147483647;
   double pcg_tolerance = 1e-6;  // relative residual |A x - b| / |b| (2-norms) at which the iteration stops
   int pcg_max_iterations = 8;

@@ -407,6 +407,12 @@ const std::vector<BadCase>& bad_cases() {
        "adaptive_time_step.max_correction", "must be > 0"},
       {"adaptive_grow_after_zero", [](Json::Value& j) { j["adaptive_time_step"]["grow_after"] = 0; },
        "adaptive_time_step.grow_after", ">= 1"},
+      {"solver_block_max_nodes_negative", [](Json::Value& j) { j["solver"]["block_max_nodes"] = -1; },
+       "solver.block_max_nodes", ">= 0"},
+      {"solver_block_max_nodes_fraction", [](Json::Value& j) { j["solver"]["block_max_nodes"] = 2.5; },
+       "solver.block_max_nodes", "integer"},
+      {"solver_pcg_tolerance_one", [](Json::Value& j) { j["solver"]["pcg_tolerance"] = 1; }, "solver.pcg_tolerance",
+       "must be in (0, 1)"},
   };
   return cases;
 }
@@ -610,6 +616,22 @@ TEST(SceneParser, FractureSubstepOpenings) {
   j["fracture"]["substep_openings"] = "independent";
   SceneFixture f(j);
   EXPECT_TRUE(f.load().fracture.independent_openings);
+}
+
+// `solver`: the defaults of physics/solver_settings.hpp unless given.
+TEST(SceneParser, SolverSettings) {
+  const Scene defaults = SceneFixture(base_scene()).load();
+  EXPECT_EQ(defaults.solver.block_max_nodes, SolverSettings().block_max_nodes);
+  EXPECT_EQ(defaults.solver.pcg_min_nodes, SolverSettings().pcg_min_nodes);
+  Json::Value j = base_scene();
+  j["solver"] = parse_text(R"({"block_max_nodes": 0, "pcg_min_nodes": 5000, "pcg_tolerance": 1e-8,
+                               "pcg_max_iterations": 20})");
+  const Scene set = SceneFixture(j).load();
+  EXPECT_EQ(set.solver.block_max_nodes, 0);
+  EXPECT_EQ(set.solver.pcg_min_nodes, 5000);
+  EXPECT_DOUBLE_EQ(set.solver.pcg_tolerance, 1e-8);
+  EXPECT_EQ(set.solver.pcg_max_iterations, 20);
+  EXPECT_TRUE(set.warnings.empty());
 }
 
 TEST(SceneParser, MagicAndWind) {

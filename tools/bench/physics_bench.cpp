@@ -45,10 +45,12 @@ struct BenchSheet {
 
 // The solver's default settings (physics/solver_settings.hpp); `direct` factorises at every step (the solver
 // before 2026-12-05, and what systems below pcg_min_nodes get).
-void run_implicit_steps(benchmark::State& state, bool direct) {
+// `block_max_nodes` < 0 keeps the default choice between BlockCholesky and CHOLMOD.
+void run_implicit_steps(benchmark::State& state, bool direct, int block_max_nodes = -1) {
   BenchSheet sheet(static_cast<int>(state.range(0)));
   SolverSettings settings;
   if (direct) settings.pcg_min_nodes = std::numeric_limits<int>::max();
+  if (block_max_nodes >= 0) settings.block_max_nodes = block_max_nodes;
   if (const char* tolerance = std::getenv("ARCSIM_BENCH_PCG_TOLERANCE")) settings.pcg_tolerance = std::atof(tolerance);
   if (const char* iterations = std::getenv("ARCSIM_BENCH_PCG_MAX_ITERATIONS"))
     settings.pcg_max_iterations = std::atoi(iterations);
@@ -61,6 +63,7 @@ void run_implicit_steps(benchmark::State& state, bool direct) {
   double max_residual = 0;
   for (double r : timing.residuals) max_residual = std::max(max_residual, r);
   state.counters["faces"] = static_cast<double>(sheet.mesh.faces.size());
+  state.counters["nodes"] = static_cast<double>(sheet.mesh.nodes.size());
   state.counters["assembly_ms"] = 1e3 * timing.assembly / steps;
   state.counters["factor_ms"] = 1e3 * timing.factorization / steps;
   state.counters["solve_ms"] = 1e3 * timing.solve / steps;
@@ -75,6 +78,16 @@ void BM_ImplicitStepDirect(benchmark::State& state) { run_implicit_steps(state, 
 BENCHMARK(BM_ImplicitStep)->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 BENCHMARK(BM_ImplicitStepDirect)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// Small systems: the same step with every system factorised by BlockCholesky (second argument 1) or by CHOLMOD
+// (0), to place SolverSettings::block_max_nodes where the two cross.
+void BM_ImplicitStepSmall(benchmark::State& state) {
+  run_implicit_steps(state, true, state.range(1) ? std::numeric_limits<int>::max() : 0);
+}
+BENCHMARK(BM_ImplicitStepSmall)
+    ->ArgsProduct({{100, 200, 400, 800, 1600, 3200, 6400}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond)
+    ->MinTime(0.5);
 
 }  // namespace
 }  // namespace arcsim
