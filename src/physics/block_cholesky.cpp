@@ -2,8 +2,11 @@
 
 #include <amd.h>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
-#include <cstring>
 #include <stdexcept>
 
 #include "physics/block_system.hpp"
@@ -14,16 +17,114 @@ namespace {
 using PanelBlock = Eigen::Map<Mat3, 0, Eigen::OuterStride<>>;
 using ConstPanelBlock = Eigen::Map<const Mat3, 0, Eigen::OuterStride<>>;
 
-// Two doubles as one SIMD register (GCC/Clang vector extension; SSE2 on x86-64): element-wise arithmetic, the
-// same rounding as two scalar operations.
-typedef double Pair __attribute__((vector_size(16)));
-inline Pair load_pair(const double* p) {
-  Pair v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
+// A block row of a panel is padded to four rows (the fourth always zero), so that the update's unit, one column of
+// a 3x3 block, is one 4-wide vector.
+constexpr int kRows = 4;
+
+// The update of column j by column k (left-looking): W(i, j) -= L(i, k) L(j, k)' for the rows i of column k from
+// position `from` to `to`. `k_panel` is column k's panel (leading dimension k_lead), `m` L(j, k) row by row; the
+// block row of column j's `panel` (leading dimension `lead`) that row s of column k updates is where[rows_k[s]].
+struct ColumnUpdate {
+  const double* k_panel;
+  int k_lead;
+  int from, to;
+  const int* rows_k;
+  const int* where;
+  double* panel;
+  int lead;
+};
+
+void update_column_generic(const ColumnUpdate& u, const double (&m)[9]) {
+  const double* c0 = u.k_panel;
+  const double* c1 = u.k_panel + u.k_lead;
+  const double* c2 = u.k_panel + 2 * u.k_lead;
+  const int* const rows_k = u.rows_k;
+  const int* const where = u.where;
+  double* const panel = u.panel;
+  const int lead = u.lead;
+  for (int s = u.from; s < u.to; ++s) {
+    const int q = kRows * s;
+    double* w = panel + kRows * where[rows_k[s]];
+    for (int b = 0; b < 3; ++b, w += lead)
+      for (int a = 0; a < 3; ++a) w[a] -= c0[q + a] * m[3 * b] + c1[q + a] * m[3 * b + 1] + c2[q + a] * m[3 * b + 2];
+  }
 }
-inline Pair broadcast(double x) { return Pair{x, x}; }
-inline void store_pair(double* p, Pair v) { std::memcpy(p, &v, sizeof v); }
+
+// A diagonal block's Cholesky factor: the reciprocals of its diagonal and its entries below the diagonal.
+struct DiagonalFactor {
+  double inverse0, inverse1, inverse2, l10, l20, l21;
+};
+
+// The blocks of a panel below its diagonal block, W, become X with X L_jj' = W (forward substitution by columns).
+void divide_below_generic(double* panel, int lead, const DiagonalFactor& d) {
+  for (int r = kRows; r < lead; r += kRows)
+    for (int a = 0; a < 3; ++a) {
+      double& x0 = panel[r + a];
+      double& x1 = panel[r + a + lead];
+      double& x2 = panel[r + a + 2 * lead];
+      x0 *= d.inverse0;
+      x1 = (x1 - d.l10 * x0) * d.inverse1;
+      x2 = (x2 - d.l20 * x0 - d.l21 * x1) * d.inverse2;
+    }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2,fma"))) void divide_below_avx2(double* panel, int lead, const DiagonalFactor& d) {
+  const __m256d inverse0 = _mm256_set1_pd(d.inverse0), inverse1 = _mm256_set1_pd(d.inverse1),
+                inverse2 = _mm256_set1_pd(d.inverse2);
+  const __m256d l10 = _mm256_set1_pd(d.l10), l20 = _mm256_set1_pd(d.l20), l21 = _mm256_set1_pd(d.l21);
+  for (int r = kRows; r < lead; r += kRows) {
+    const __m256d x0 = _mm256_mul_pd(_mm256_loadu_pd(panel + r), inverse0);
+    const __m256d x1 = _mm256_mul_pd(_mm256_fnmadd_pd(l10, x0, _mm256_loadu_pd(panel + r + lead)), inverse1);
+    const __m256d w2 = _mm256_fnmadd_pd(l20, x0, _mm256_loadu_pd(panel + r + 2 * lead));
+    _mm256_storeu_pd(panel + r, x0);
+    _mm256_storeu_pd(panel + r + lead, x1);
+    _mm256_storeu_pd(panel + r + 2 * lead, _mm256_mul_pd(_mm256_fnmadd_pd(l21, x1, w2), inverse2));
+  }
+}
+
+// The update with one AVX2 vector per block column and fused multiply-adds (so other rounding than the generic
+// kernel's: a machine uses one kernel for all its runs, so its results stay bit-identical).
+__attribute__((target("avx2,fma"))) void update_column_avx2(const ColumnUpdate& u, const double (&m)[9]) {
+  const double* c0 = u.k_panel;
+  const double* c1 = u.k_panel + u.k_lead;
+  const double* c2 = u.k_panel + 2 * u.k_lead;
+  const __m256d m00 = _mm256_set1_pd(m[0]), m01 = _mm256_set1_pd(m[1]), m02 = _mm256_set1_pd(m[2]);
+  const __m256d m10 = _mm256_set1_pd(m[3]), m11 = _mm256_set1_pd(m[4]), m12 = _mm256_set1_pd(m[5]);
+  const __m256d m20 = _mm256_set1_pd(m[6]), m21 = _mm256_set1_pd(m[7]), m22 = _mm256_set1_pd(m[8]);
+  // In locals: the stores below could otherwise alias u's fields, which would then be reloaded every row.
+  const int* const rows_k = u.rows_k;
+  const int* const where = u.where;
+  double* const panel = u.panel;
+  const int lead = u.lead;
+  for (int s = u.from; s < u.to; ++s) {
+    const int q = kRows * s;
+    const __m256d a = _mm256_loadu_pd(c0 + q), b = _mm256_loadu_pd(c1 + q), c = _mm256_loadu_pd(c2 + q);
+    double* w = panel + kRows * where[rows_k[s]];
+    __m256d x = _mm256_loadu_pd(w);
+    x = _mm256_fnmadd_pd(a, m00, x);
+    x = _mm256_fnmadd_pd(b, m01, x);
+    _mm256_storeu_pd(w, _mm256_fnmadd_pd(c, m02, x));
+    w += lead;
+    x = _mm256_loadu_pd(w);
+    x = _mm256_fnmadd_pd(a, m10, x);
+    x = _mm256_fnmadd_pd(b, m11, x);
+    _mm256_storeu_pd(w, _mm256_fnmadd_pd(c, m12, x));
+    w += lead;
+    x = _mm256_loadu_pd(w);
+    x = _mm256_fnmadd_pd(a, m20, x);
+    x = _mm256_fnmadd_pd(b, m21, x);
+    _mm256_storeu_pd(w, _mm256_fnmadd_pd(c, m22, x));
+  }
+}
+
+bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+#else
+void update_column_avx2(const ColumnUpdate& u, const double (&m)[9]) { update_column_generic(u, m); }
+void divide_below_avx2(double* panel, int lead, const DiagonalFactor& d) { divide_below_generic(panel, lead, d); }
+bool cpu_has_avx2_fma() { return false; }
+#endif
+
 }  // namespace
 
 void BlockCholesky::analyse(const BlockPattern& pattern) {
@@ -109,25 +210,26 @@ void BlockCholesky::analyse(const BlockPattern& pattern) {
     const int i = std::max(a, b), j = std::min(a, b);
     const auto first = row_.begin() + col_start_[j], last = row_.begin() + col_start_[j + 1];
     const int t = static_cast<int>(std::lower_bound(first, last, i) - first);
-    place_[k] = 9 * col_start_[j] + 3 * t;
-    lead_[k] = 3 * (col_start_[j + 1] - col_start_[j]);
+    place_[k] = 3 * kRows * col_start_[j] + kRows * t;
+    lead_[k] = kRows * (col_start_[j + 1] - col_start_[j]);
     transpose_[k] = a < b;
   }
   std::vector<char> from_a(row_.size(), 0);
   for (int k = 0; k < blocks; ++k) {
     const int a = position[pattern.block_row(k)], b = position[pattern.block_col(k)];
     const int j = std::min(a, b);
-    from_a[col_start_[j] + (place_[k] - 9 * col_start_[j]) / 3] = 1;
+    from_a[col_start_[j] + (place_[k] - 3 * kRows * col_start_[j]) / kRows] = 1;
   }
   fill_.clear();
   fill_lead_.clear();
   for (int j = 0; j < n; ++j)
     for (int t = col_start_[j]; t < col_start_[j + 1]; ++t)
       if (!from_a[t]) {
-        fill_.push_back(9 * col_start_[j] + 3 * (t - col_start_[j]));
-        fill_lead_.push_back(3 * (col_start_[j + 1] - col_start_[j]));
+        fill_.push_back(3 * kRows * col_start_[j] + kRows * (t - col_start_[j]));
+        fill_lead_.push_back(kRows * (col_start_[j + 1] - col_start_[j]));
       }
-  value_.assign(9 * row_.size(), 0.0);
+  value_.assign(3 * kRows * row_.size(), 0.0);
+  avx2_ = kernel_ == Kernel::kFastest && cpu_has_avx2_fma();
   where_.assign(n, 0);
   next_row_.assign(n, 0);
   list_head_.assign(n, -1);
@@ -136,6 +238,8 @@ void BlockCholesky::analyse(const BlockPattern& pattern) {
 
 bool BlockCholesky::factorize(const BlockSystem& system) {
   const int n = node_count_;
+  // A failed factorisation may have left non-finite values in the padding rows, which nothing else rewrites.
+  if (failed_row_ >= 0) std::fill(value_.begin(), value_.end(), 0.0);
   failed_row_ = -1;
   // Every block of L is either one of A's (copied whole) or fill (zeroed).
   for (size_t f = 0; f < fill_.size(); ++f) PanelBlock(&value_[fill_[f]], Eigen::OuterStride<>(fill_lead_[f])).setZero();
@@ -151,42 +255,24 @@ bool BlockCholesky::factorize(const BlockSystem& system) {
   // Left-looking: column j gathers the updates of every earlier column k with a block in row j (the columns
   // linked in list_head_[j]), then is factorised. next_row_[k] is where column k's next row to visit lies in row_.
   for (int j = 0; j < n; ++j) {
-    const int begin = col_start_[j], rows = col_start_[j + 1] - begin, lead = 3 * rows;
-    double* panel = &value_[9 * begin];
+    const int begin = col_start_[j], rows = col_start_[j + 1] - begin, lead = kRows * rows;
+    double* panel = &value_[3 * kRows * begin];
     for (int t = 0; t < rows; ++t) where_[row_[begin + t]] = t;
     for (int k = list_head_[j]; k != -1;) {
       const int following = list_next_[k];
       const int p = next_row_[k];
-      const int k_begin = col_start_[k], k_rows = col_start_[k + 1] - k_begin, k_lead = 3 * k_rows;
-      const double* k_panel = &value_[9 * k_begin];
+      const int k_begin = col_start_[k], k_rows = col_start_[k + 1] - k_begin, k_lead = kRows * k_rows;
+      const double* k_panel = &value_[3 * kRows * k_begin];
       const int local = p - k_begin;
-      // W(i, j) -= L(i, k) L(j, k)' for every row i of column k from j down. Column b of the update combines
-      // L(:, k)'s three columns with row b of L(j, k), contiguous in the panel.
-      // Columns j and k are distinct panels: nothing written below is read through c0..c2.
-      const double* __restrict c0 = k_panel;
-      const double* __restrict c1 = k_panel + k_lead;
-      const double* __restrict c2 = k_panel + 2 * k_lead;
-      const int j_row = 3 * local;
-      const int* rows_k = &row_[k_begin];
-      // Row b of L(j, k), each entry in both halves of a pair.
-      const Pair m00 = broadcast(c0[j_row]), m01 = broadcast(c1[j_row]), m02 = broadcast(c2[j_row]);
-      const Pair m10 = broadcast(c0[j_row + 1]), m11 = broadcast(c1[j_row + 1]), m12 = broadcast(c2[j_row + 1]);
-      const Pair m20 = broadcast(c0[j_row + 2]), m21 = broadcast(c1[j_row + 2]), m22 = broadcast(c2[j_row + 2]);
-      for (int s = local; s < k_rows; ++s) {
-        // Block L(i, k) (rows 0-1 as pairs, row 2 as scalars) times L(j, k)', subtracted from block W(i, j).
-        const int q = 3 * s;
-        const Pair a = load_pair(c0 + q), b = load_pair(c1 + q), c = load_pair(c2 + q);
-        const double a2 = c0[q + 2], b2 = c1[q + 2], c2s = c2[q + 2];
-        double* w = panel + 3 * where_[rows_k[s]];
-        store_pair(w, load_pair(w) - (a * m00 + b * m01 + c * m02));
-        w[2] -= a2 * m00[0] + b2 * m01[0] + c2s * m02[0];
-        w += lead;
-        store_pair(w, load_pair(w) - (a * m10 + b * m11 + c * m12));
-        w[2] -= a2 * m10[0] + b2 * m11[0] + c2s * m12[0];
-        w += lead;
-        store_pair(w, load_pair(w) - (a * m20 + b * m21 + c * m22));
-        w[2] -= a2 * m20[0] + b2 * m21[0] + c2s * m22[0];
-      }
+      const double* j_row = k_panel + kRows * local;
+      const double m[9] = {j_row[0], j_row[k_lead], j_row[2 * k_lead],
+                           j_row[1], j_row[1 + k_lead], j_row[1 + 2 * k_lead],
+                           j_row[2], j_row[2 + k_lead], j_row[2 + 2 * k_lead]};
+      const ColumnUpdate update{k_panel, k_lead, local, k_rows, &row_[k_begin], where_.data(), panel, lead};
+      if (avx2_)
+        update_column_avx2(update, m);
+      else
+        update_column_generic(update, m);
       if (local + 1 < k_rows) {
         next_row_[k] = p + 1;
         const int r = row_[p + 1];
@@ -209,15 +295,12 @@ bool BlockCholesky::factorize(const BlockSystem& system) {
     const double l22 = std::sqrt(d2);
     diagonal << l00, 0, 0, l10, l11, 0, l20, l21, l22;
 
-    // The blocks below: X L_jj' = W, row by row.
-    for (int r = 3; r < lead; ++r) {
-      double& x0 = panel[r];
-      double& x1 = panel[r + lead];
-      double& x2 = panel[r + 2 * lead];
-      x0 /= l00;
-      x1 = (x1 - l10 * x0) / l11;
-      x2 = (x2 - l20 * x0 - l21 * x1) / l22;
-    }
+    // The blocks below: X L_jj' = W.
+    const DiagonalFactor factor{1 / l00, 1 / l11, 1 / l22, l10, l20, l21};
+    if (avx2_)
+      divide_below_avx2(panel, lead, factor);
+    else
+      divide_below_generic(panel, lead, factor);
     if (rows > 1) {
       next_row_[j] = begin + 1;
       const int r = row_[begin + 1];
@@ -234,21 +317,22 @@ VecX BlockCholesky::solve(const VecX& b) const {
   for (int j = 0; j < n; ++j) y.segment<3>(3 * j) = b.segment<3>(3 * order_[j]);
   // L y' = y, then L' x = y'.
   for (int j = 0; j < n; ++j) {
-    const int begin = col_start_[j], lead = 3 * (col_start_[j + 1] - begin);
-    const double* panel = &value_[9 * begin];
+    const int begin = col_start_[j], lead = kRows * (col_start_[j + 1] - begin);
+    const double* panel = &value_[3 * kRows * begin];
     const Vec3 yj = ConstPanelBlock(panel, Eigen::OuterStride<>(lead))
                         .triangularView<Eigen::Lower>()
                         .solve(Vec3(y.segment<3>(3 * j)));
     y.segment<3>(3 * j) = yj;
     for (int t = 1; t < col_start_[j + 1] - begin; ++t)
-      y.segment<3>(3 * row_[begin + t]).noalias() -= ConstPanelBlock(panel + 3 * t, Eigen::OuterStride<>(lead)) * yj;
+      y.segment<3>(3 * row_[begin + t]).noalias() -=
+          ConstPanelBlock(panel + kRows * t, Eigen::OuterStride<>(lead)) * yj;
   }
   for (int j = n - 1; j >= 0; --j) {
-    const int begin = col_start_[j], lead = 3 * (col_start_[j + 1] - begin);
-    const double* panel = &value_[9 * begin];
+    const int begin = col_start_[j], lead = kRows * (col_start_[j + 1] - begin);
+    const double* panel = &value_[3 * kRows * begin];
     Vec3 s = y.segment<3>(3 * j);
     for (int t = 1; t < col_start_[j + 1] - begin; ++t)
-      s.noalias() -= ConstPanelBlock(panel + 3 * t, Eigen::OuterStride<>(lead)).transpose() *
+      s.noalias() -= ConstPanelBlock(panel + kRows * t, Eigen::OuterStride<>(lead)).transpose() *
                      y.segment<3>(3 * row_[begin + t]);
     y.segment<3>(3 * j) =
         ConstPanelBlock(panel, Eigen::OuterStride<>(lead)).transpose().triangularView<Eigen::Upper>().solve(s);

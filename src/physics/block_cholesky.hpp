@@ -19,6 +19,11 @@ struct BlockSystem;
 
 class BlockCholesky {
  public:
+  // The numeric phase's inner kernels: AVX2 with fused multiply-adds where the CPU has them (x86-64), else plain
+  // C++. Both are exact to round-off; they round differently, and a machine always takes the same one.
+  enum class Kernel { kFastest, kGeneric };
+  explicit BlockCholesky(Kernel kernel = Kernel::kFastest) : kernel_(kernel) {}
+
   // Symbolic phase for a pattern: ordering, elimination tree and the block pattern of the factor. Valid for every
   // system on a pattern of the same id.
   void analyse(const BlockPattern& pattern);
@@ -33,13 +38,15 @@ class BlockCholesky {
   // Scalar entries of the factor (block entries x 9, diagonal blocks counted whole), and the flops of one
   // numeric phase: what the analysis decided, for tests and benchmarks.
   long factor_entries() const { return 9L * static_cast<long>(row_.size()); }
+  // Whether the numeric phase uses the AVX2/FMA kernels (kFastest on a CPU that has them).
+  bool uses_avx2() const { return avx2_; }
   double factor_flops() const { return flops_; }
 
  private:
   int node_count_ = 0;
   std::vector<int> order_;        // permuted position k holds node order_[k]
   // Column j of L (permuted numbering): block rows row_[col_start_[j]] = j < ... (ascending), stored as a
-  // column-major panel of 3 * rows x 3 doubles at value_[9 * col_start_[j]].
+  // column-major panel of 4 * rows x 3 doubles at value_[12 * col_start_[j]], each block's fourth row zero.
   std::vector<int> col_start_, row_;
   // Where A's blocks go: block k of the pattern is added at value_[place_[k]] (column-major, leading dimension
   // lead_[k]), transposed when its permuted row lies above its permuted column.
@@ -50,6 +57,8 @@ class BlockCholesky {
   std::vector<double> value_;
   double flops_ = 0;
   int failed_row_ = -1;
+  Kernel kernel_;
+  bool avx2_ = false;  // the kernels in use: AVX2 with FMA
   // Scratch of the numeric phase, kept to avoid allocating per factorisation.
   std::vector<int> where_, next_row_, list_head_, list_next_;
 };

@@ -18,7 +18,7 @@ struct SolverSettings {
   // Systems of at most this many nodes are factorised by BlockCholesky (3x3 node blocks, no per-supernode
   // overhead), larger ones by CHOLMOD's supernodal factorisation, which wins once its supernodes are wide
   // (docs/benchmarks.md, "Small systems' factorisation").
-  int block_max_nodes = 300;
+  int block_max_nodes = 1000;
   int pcg_min_nodes = 2147483647;
   double pcg_tolerance = 1e-6;  // relative residual |A x - b| / |b| (2-norms) at which the iteration stops
   int pcg_max_iterations = 8;
