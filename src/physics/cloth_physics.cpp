@@ -309,9 +309,11 @@ double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements,
       evaluate(el, r.terms);
       r.scale = how.stiffness_scale + how.damping_scale * el.damping;
       r.rhs = -how.force_scale * r.terms.gradient;
+      // lazyProduct: a fixed-size product Eigen unrolls (its general matrix-vector kernel costs twice as much
+      // at 18x18).
       if (need_velocity)
         r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 (r.terms.hessian * gather_velocity<N>(mesh, el.nodes));
+                 r.terms.hessian.lazyProduct(gather_velocity<N>(mesh, el.nodes));
     }
     for (int i = begin; i < end; ++i) {
       energy += results[i - begin].terms.energy;

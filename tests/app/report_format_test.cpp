@@ -4,7 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "app/frame_report.hpp"
 #include "app/json_line.hpp"
@@ -32,6 +37,30 @@ TEST(JsonNumber, ShortestFormThatReadsBackExactly) {
   EXPECT_EQ(std::stod(json_number(third)), third);
   EXPECT_EQ(json_number(std::nan("")), "null");
   EXPECT_EQ(json_number(-INFINITY), "null");
+}
+
+// The same text as printf's %.*g with the fewest digits from 6 on that strtod reads back exactly (the form the
+// log always had), over magnitudes from denormals to 1e300, round numbers and integers included.
+TEST(JsonNumber, SameTextAsPrintfsShortestRoundTrip) {
+  auto reference = [](double x) {
+    char buffer[40];
+    for (int digits = 6; digits <= 17; ++digits) {
+      std::snprintf(buffer, sizeof buffer, "%.*g", digits, x);
+      if (std::strtod(buffer, nullptr) == x) break;
+    }
+    return std::string(buffer);
+  };
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> mantissa(-10, 10);
+  std::uniform_int_distribution<int> exponent(-320, 300);
+  std::vector<double> values = {0.0, -0.0, 1.0, 100000.0, 1e6, 123456789.0, 5e-324, 2.2250738585072014e-308,
+                                1.7976931348623157e308, 0.1, 1e-5, 9.999999e-5, 0.5};
+  for (int i = 0; i < 20000; ++i) values.push_back(mantissa(rng) * std::pow(10.0, exponent(rng)));
+  for (int i = 0; i < 2000; ++i) values.push_back(std::round(mantissa(rng) * 1e4));
+  for (double x : values)
+    if (std::isfinite(x)) {
+      EXPECT_EQ(json_number(x), reference(x)) << x;
+    }
 }
 
 TEST(FrameLog, LineParsesWithEveryFieldInOrder) {
