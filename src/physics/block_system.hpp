@@ -163,7 +163,7 @@ class CholeskySolver {
   void set_settings(const SolverSettings& settings) { settings_ = settings; }
   int analyses() const { return analyses_; }
   int factorizations() const { return factorizations_; }
-  // After a failed factorisation: the matrix row where CHOLMOD met a non-positive pivot (row / 3 is the
+  // After a failed factorisation: the matrix row (in its own order) whose pivot was not positive (row / 3 is the
   // system's dof); -1 otherwise.
   int failed_row() const { return block_ ? block_->failed_row() : llt_ ? llt_->failed_row() : -1; }
   // Whether the last analysis chose the node-block factorisation (small systems) rather than CHOLMOD's.
