@@ -347,5 +347,73 @@ TEST(ImplicitEuler, KeptBendingAnglesGiveTheSameAssembly) {
   EXPECT_EQ(memo.find(0, zero_corners, s.cache.bending[0].has_wing), nullptr);
 }
 
+
+// The assembly takes the bending Hessian in factored form (PlateBendingGaussNewton) and scatters only the blocks
+// the system keeps: the same system, up to rounding, as scattering plate_bending_terms' 18x18 Hessian with
+// BlockSystem::add_element and multiplying by it. Also where a bending element's two wings are one node (a
+// valence-3 node inside a triangle), whose diagonal block takes both cross blocks.
+TEST(ImplicitEuler, FactoredBendingAssemblyEqualsTheFullHessians) {
+  const std::vector<Vec3> p{Vec3(0, 0, 0),  Vec3(0.2, 0, 0),    Vec3(0.1, 0.2, 0),  Vec3(0.1, 0.07, 0),
+                            Vec3(0.1, -0.2, 0), Vec3(-0.15, 0.2, 0), Vec3(-0.2, -0.05, 0)};
+  const std::vector<std::array<int, 3>> tris{{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {1, 0, 4}, {0, 2, 5}, {0, 5, 6}, {0, 6, 4}};
+  std::vector<Mesh> meshes{Mesh::from_triangles(p, p, {0, 1, 2, 3, 4, 5, 6}, tris),
+                           testing::make_grid(5, 4, 0.3, 0.2, testing::Diagonal::kAlternating)};
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    Sheet s(meshes[m]);
+    bool repeated_wing = false;
+    for (const BendingElement& b : s.cache.bending)
+      for (int i = 0; i < 3; ++i)
+        for (int j = i + 1; j < 3; ++j)
+          repeated_wing |= b.has_wing[i] && b.has_wing[j] && b.nodes[3 + i] == b.nodes[3 + j];
+    EXPECT_EQ(repeated_wing, m == 0);
+    for (size_t i = 0; i < s.mesh.nodes.size(); ++i) {
+      Node& node = s.mesh.nodes[i];
+      node.x.z() = 0.02 * std::sin(7.0 * node.x.x() + i) * std::cos(5.0 * node.x.y());
+      node.v = Vec3(0.01 * i, -0.02, 0.03 * std::cos(1.0 * i));
+    }
+    InternalAssembly how;
+    how.stiffness_scale = 1e-4;
+    how.damping_scale = 0.01;
+    how.force_scale = 0.01;
+    how.velocity_scale = 1e-4;
+    how.damping_velocity_scale = 0.01;
+    BlockSystem factored, full;
+    factored.reset(s.cache.pattern);
+    full.reset(s.cache.pattern);
+    const double energy = assemble_element_terms(s.mesh, s.cache.faces, s.cache.bending, how, factored);
+    double full_energy = assemble_element_terms(s.mesh, s.cache.faces, {}, how, full);
+    for (const BendingElement& b : s.cache.bending) {
+      std::array<Vec3, 6> x;
+      Vec18 v;
+      for (int i = 0; i < 6; ++i) x[i] = s.mesh.nodes[b.nodes[i]].x, v.segment<3>(3 * i) = s.mesh.nodes[b.nodes[i]].v;
+      const PlateBendingTerms t = plate_bending_terms(x, b.has_wing, b.rest_theta, b.Q, HessianKind::kProjected);
+      full_energy += t.energy;
+      full.add_element<6>(b.dofs, b.blocks, t.hessian, how.stiffness_scale + how.damping_scale * b.damping);
+      const Vec18 rhs = -how.force_scale * t.gradient -
+                        (how.velocity_scale + how.damping_velocity_scale * b.damping) * (t.hessian * v);
+      for (int i = 0; i < 6; ++i) full.rhs.segment<3>(3 * b.dofs[i]) += rhs.segment<3>(3 * i);
+      // The factored form's own blocks and product.
+      PlateBendingFactoredTerms f;
+      plate_bending_factored_terms(x, b.has_wing, b.rest_theta, b.Q, f);
+      EXPECT_EQ(f.energy, t.energy);
+      EXPECT_TRUE(f.gradient == t.gradient);
+      EXPECT_LE((f.hessian.times(v) - t.hessian * v).norm(), 1e-12 * (t.hessian.norm() * v.norm()));
+      for (int a = 0; a < 6; ++a) {
+        for (int c = a; c < 6; ++c) {
+          if (f.hessian.slot_used(a) && f.hessian.slot_used(c)) {
+            EXPECT_TRUE((f.hessian.block(a, c) == t.hessian.block<3, 3>(3 * a, 3 * c)));
+          }
+        }
+      }
+    }
+    EXPECT_NEAR(energy, full_energy, 1e-14 * full_energy);
+    double scale = 0;
+    for (const Mat3& B : full.blocks) scale = std::max(scale, B.norm());
+    ASSERT_GT(scale, 0);
+    for (size_t k = 0; k < full.blocks.size(); ++k)
+      EXPECT_LE((factored.blocks[k] - full.blocks[k]).norm(), 1e-13 * scale) << "mesh " << m << " block " << k;
+    EXPECT_LE((factored.rhs - full.rhs).norm(), 1e-12 * full.rhs.norm()) << "mesh " << m;
+  }
+}
 }  // namespace
 }  // namespace arcsim
