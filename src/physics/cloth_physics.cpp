@@ -237,40 +237,10 @@ struct ElementResult {
   Eigen::Matrix<double, 3 * N, 1> rhs;
 };
 
-// The element Hessian's lower blocks times `scale` into the system: from the matrix, or (plate bending) from its
-// factored form, computing only the blocks the system takes.
-template <std::size_t N, int R>
-void add_hessian(const std::array<int, N>& dofs, const std::array<int, N * N>& blocks,
-                 const Eigen::Matrix<double, R, R>& hessian, double scale, BlockSystem& system) {
-  system.add_element<static_cast<int>(N)>(dofs, blocks, hessian, scale);
-}
-
-void add_hessian(const std::array<int, 6>& dofs, const std::array<int, 36>& blocks,
-                 const PlateBendingGaussNewton& hessian, double scale, BlockSystem& system) {
-  for (int a = 0; a < 6; ++a) {
-    if (dofs[a] < 0 || !hessian.slot_used(a)) continue;
-    for (int b = 0; b < 6; ++b) {
-      // The pairs BlockSystem::add_element takes (a node in two slots gets both cross blocks); unused wing slots'
-      // blocks are zero.
-      if (dofs[b] < 0 || dofs[a] < dofs[b] || !hessian.slot_used(b)) continue;
-      system.blocks[blocks[a * 6 + b]] += scale * hessian.block(a, b);
-    }
-  }
-}
-
-// lazyProduct: a fixed-size product Eigen unrolls (its general matrix-vector kernel costs twice as much at 18x18).
-template <int R>
-Eigen::Matrix<double, R, 1> hessian_times(const Eigen::Matrix<double, R, R>& hessian,
-                                          const Eigen::Matrix<double, R, 1>& v) {
-  return hessian.lazyProduct(v);
-}
-
-Vec18 hessian_times(const PlateBendingGaussNewton& hessian, const Vec18& v) { return hessian.times(v); }
-
 template <int N, typename Terms>
 void scatter(const std::array<int, N>& dofs, const std::array<int, N * N>& blocks, const ElementResult<N, Terms>& r,
              BlockSystem& system) {
-  add_hessian(dofs, blocks, r.terms.hessian, r.scale, system);
+  system.add_element<N>(dofs, blocks, r.terms.hessian, r.scale);
   for (int i = 0; i < N; ++i)
     if (dofs[i] >= 0) system.rhs.segment<3>(3 * dofs[i]) += r.rhs.template segment<3>(3 * i);
 }
@@ -339,9 +309,11 @@ double assemble_elements(const Mesh& mesh, const std::vector<Element>& elements,
       evaluate(el, r.terms);
       r.scale = how.stiffness_scale + how.damping_scale * el.damping;
       r.rhs = -how.force_scale * r.terms.gradient;
+      // lazyProduct: a fixed-size product Eigen unrolls (its general matrix-vector kernel costs twice as much
+      // at 18x18).
       if (need_velocity)
         r.rhs -= (how.velocity_scale + how.damping_velocity_scale * el.damping) *
-                 hessian_times(r.terms.hessian, gather_velocity<N>(mesh, el.nodes));
+                 r.terms.hessian.lazyProduct(gather_velocity<N>(mesh, el.nodes));
     }
     for (int i = begin; i < end; ++i) {
       energy += results[i - begin].terms.energy;
@@ -363,12 +335,12 @@ double assemble_element_terms(const Mesh& mesh, const std::vector<FaceElement>& 
                            el.Dm_inv, el.area, el.k, 1.0, HessianKind::kProjected);
       },
       system);
-  energy += assemble_elements<6, PlateBendingFactoredTerms>(
+  energy += assemble_elements<6, PlateBendingTerms>(
       mesh, bending, how,
-      [&](const BendingElement& el, PlateBendingFactoredTerms& t) {
+      [&](const BendingElement& el, PlateBendingTerms& t) {
         const std::array<Vec3, 6> x = gather_positions(mesh, el.nodes);
         const Vec3* theta = angles ? angles->find(static_cast<size_t>(&el - bending.data()), x, el.has_wing) : nullptr;
-        plate_bending_factored_terms(x, el.has_wing, el.rest_theta, el.Q, t, theta);
+        plate_bending_terms(x, el.has_wing, el.rest_theta, el.Q, HessianKind::kProjected, t, theta);
       },
       system);
   return energy;

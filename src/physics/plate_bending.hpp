@@ -60,44 +60,6 @@ void plate_bending_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>
                          const Mat3& Q, HessianKind hessian, PlateBendingTerms& out,
                          const Vec3* known_theta = nullptr);
 
-// The Gauss-Newton Hessian 2 J^T Q J of one element in factored form, for the assembly: it scatters the blocks
-// and multiplies by the matrix without forming the 18x18 matrix (three quarters of which the lower-block scatter
-// never reads). G[p] holds slot p's rows of the three hinge gradients as columns (column i: hinge i's gradient
-// at slot p, zero where slot p is not in hinge i), so that block (p, q) is 2 G_p Q G_q^T.
-struct PlateBendingGaussNewton {
-  std::array<Mat3, 6> G;
-  std::array<Mat3, 6> GQ;  // 2 G_p Q
-  std::array<bool, 3> has_wing{};
-
-  bool slot_used(int p) const { return p < 3 || has_wing[p - 3]; }
-  // Block (p, q), both slots used. plate_bending_terms' Hessian has block(p, q) for p <= q, mirrored.
-  // Written out: Eigen's 3x3 product is an out-of-line call per block here, the assembly's largest cost.
-  Mat3 block(int p, int q) const {
-    Mat3 out;
-    if (q >= 3) {
-      out.noalias() = GQ[p].col(q - 3) * G[q].col(q - 3).transpose();  // wing q: G_q's one nonzero column
-      return out;
-    }
-    const Mat3 &A = GQ[p], &B = G[q];
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) out(r, c) = A(r, 0) * B(c, 0) + A(r, 1) * B(c, 1) + A(r, 2) * B(c, 2);
-    return out;
-  }
-  // H v (N) for v stacked as the element's slots: 2 G_p Q (sum_q G_q^T v_q), a 3-vector through Q.
-  Vec18 times(const Vec18& v) const;
-};
-
-// plate_bending_terms with HessianKind::kProjected, the Hessian in factored form (same energy, gradient, angles).
-struct PlateBendingFactoredTerms {
-  double energy = 0;
-  Vec18 gradient = Vec18::Zero();
-  PlateBendingGaussNewton hessian;
-  Vec3 theta = Vec3::Zero();
-};
-void plate_bending_factored_terms(const std::array<Vec3, 6>& x, const std::array<bool, 3>& has_wing,
-                                  const Vec3& rest_theta, const Mat3& Q, PlateBendingFactoredTerms& out,
-                                  const Vec3* known_theta = nullptr);
-
 // The energy alone (J), equal to plate_bending_terms(...).energy, without the angles' gradients (for energy
 // checks that evaluate every element several times per step).
 // `theta`, if given, gets the world dihedral angles as plate_bending_terms gives them (0 where no wing).
