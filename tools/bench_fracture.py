@@ -261,7 +261,14 @@ def run_arcsim(binary, scenes_dir, scene, seconds, timeout, out):
     target = min(seconds, clock.end)
     target_steps, _ = clock.steps_to(target)
     os.makedirs(out, exist_ok=True)  # ARCSim does not create it
-    cmd = [binary, "simulateoffline", os.path.join("conf", scene + ".json"), out]
+    scene_arg = os.path.join("conf", scene + ".json")
+    if "motions" not in conf or "obstacles" not in conf:
+        # The port rejects a scene without both arrays ("Expected array, found null"; flag.json has neither):
+        # run a copy with empty ones (meshes and materials still resolve from scenes_dir, the working directory).
+        scene_arg = os.path.join(os.path.abspath(out), scene + "-arrays.json")
+        with open(scene_arg, "w") as f:
+            json.dump({"motions": [], "obstacles": [], **conf}, f)
+    cmd = [binary, "simulateoffline", scene_arg, out]
     arrivals = []  # (perf_counter, step) per "Sim frame F [S]" line
     others = []
     reached = threading.Event()
