@@ -84,6 +84,7 @@ std::string frame_log_line(const FrameReport& r) {
         .integer("retries", r.retries)
         .integer("level", r.substep_level)
         .number("smallest", r.smallest_step);
+    if (r.held_steps > 0) step.integer("held", r.held_steps);
     if (!r.retry_cause.empty()) step.text("cause", r.retry_cause);
     line.object("time_step", step);
   }

@@ -44,6 +44,7 @@ struct FrameReport {
   bool has_time_step = false;        // adaptive time stepping is on: the fields below are meaningful
   int substeps = 0;                  // dynamics substeps taken in this frame
   int retries = 0;                   // failed attempts redone with a smaller step
+  int held_steps = 0;                // steps taken with a persistent collision fallback held
   int substep_level = 0;             // the finest level used (substeps per step = 2^level)
   double smallest_step = 0;          // s
   std::string retry_cause;           // the last failure's cause ("" if none)
@@ -57,7 +58,8 @@ struct FrameReport {
 // "ill_conditioned_zones":..,"unresolved_steps":..} when has_impact_zones, then "fracture":{"cracks":..,
 // "refused":..,"substeps":..,"candidates":..,"largest_zone":..,"remesh_edits":..,"max_ratio":..,"seconds":..}
 // when has_fracture (max_ratio: the largest separation strength / toughness seen at a step's first evaluation),
-// then "time_step":{"substeps":..,"retries":..,"level":..,"smallest":..[,"cause":".."]} when has_time_step, then
+// then "time_step":{"substeps":..,"retries":..,"level":..,"smallest":..[,"held":..][,"cause":".."]} when
+// has_time_step (held when held_steps > 0), then
 // "solver":{"solves":..,"factorizations":..,"iterations":..,"max_residual":..,"residuals":[..]} when solves > 0.
 std::string frame_log_line(const FrameReport& report);
 

@@ -51,6 +51,7 @@ std::string Progress::status(const FrameReport& r) const {
     std::snprintf(buffer, sizeof buffer, "  step /%d", 1 << std::min(r.substep_level, 30));
     text += buffer;
   }
+  if (r.has_time_step && r.held_steps > 0) text += "  " + std::to_string(r.held_steps) + " held";
   if (bounded) text += "  ETA " + format_duration(per_frame * std::max(0.0, total_frames_ - r.frame));
   return text;
 }

@@ -171,6 +171,7 @@ void describe_frame(const Simulation& sim, FrameReport& report) {
   report.has_time_step = sim.scene().adaptive_step.enabled;
   report.substeps = sim.time_step_stats.substeps;
   report.retries = sim.time_step_stats.retries;
+  report.held_steps = sim.time_step_stats.held_steps;
   report.substep_level = sim.time_step_stats.level;
   report.smallest_step = sim.time_step_stats.smallest;
   report.retry_cause = sim.time_step_stats.cause;

@@ -195,12 +195,18 @@ class ZoneSet {
  public:
   explicit ZoneSet(const ContactGeometry& g) : g_(g), zone_of_(g.node_count(), kNone) {}
 
-  // Adds the impacts' constraints, creating and merging zones over shared movable nodes.
-  void add(const std::vector<ImpactRecord>& impacts) {
+  // Adds the impacts' constraints, creating and merging zones over shared movable nodes: those with a weight in
+  // the constraint, or with `whole_pairs` every movable node of the pair.
+  // WHY whole_pairs (the fallback rounds): a pair of nearly collinear edges lying along each other is found
+  // again by every detection while any of its four nodes moves, since its closest points slide along the
+  // edges; a node of weight zero at the contact left out of the zone kept moving, so the zone held at its start
+  // was hit again and the collisions stayed unresolved (conf/paper-window.json, step 68).
+  void add(const std::vector<ImpactRecord>& impacts, bool whole_pairs = false) {
     for (const ImpactRecord& r : impacts) {
       std::vector<int> movable;
       for (int i = 0; i < 4; ++i)
-        if (r.nodes[i] != kNone && r.weights[i] != 0 && g_.movable(r.nodes[i])) movable.push_back(r.nodes[i]);
+        if (r.nodes[i] != kNone && (whole_pairs || r.weights[i] != 0) && g_.movable(r.nodes[i]))
+          movable.push_back(r.nodes[i]);
       if (movable.empty()) continue;
       int target = kNone;
       for (int n : movable)
@@ -466,7 +472,7 @@ ImpactZoneStats resolve_impacts(ContactGeometry& g, BvhCache& cache, const Impac
     const std::vector<ImpactRecord> impacts = detect_impacts(g, cache, params, &moved, &stats.work);
     ++stats.iterations;
     if (impacts.empty()) return finish(true);
-    zones.add(impacts);
+    zones.add(impacts, true);
     if (!(spent() < params.work_budget)) return out_of_budget();
   }
   std::ostringstream what;

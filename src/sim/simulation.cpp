@@ -295,6 +295,7 @@ void Simulation::collision_step(double dt, bool finest_substep) {
   const ImpactZoneStats stats =
       collisions_.resolve_collisions(cloth_meshes, active_obstacle_meshes(obstacles), settings, dt);
   step_fallback_nodes_ = collisions_.fallback_nodes();
+  step_collisions_resolved_ = stats.resolved;
   if (!stats.out_of_budget) return;
   // The cause; the step names itself (Simulation::step, or the adaptive step if even its smallest substep fails).
   std::ostringstream msg;
@@ -467,13 +468,24 @@ void restore_snapshot(const DynamicsSnapshot& s, std::vector<Cloth>& cloths) {
 
 }  // namespace
 
-std::string Simulation::substep_problem(double dt) const {
+std::string Simulation::substep_problem(double dt, const std::vector<std::vector<char>>* tolerated,
+                                        bool* tolerated_used) const {
   const AdaptiveStepSpec& a = scene_.adaptive_step;
   if (a.reject_fallbacks)
-    for (size_t c = 0; c < step_fallback_nodes_.size(); ++c)
-      if (!step_fallback_nodes_[c].empty())
-        return "the collision response of cloth " + std::to_string(c) + " needed a fallback (" +
-               std::to_string(step_fallback_nodes_[c].size()) + " nodes moved rigidly or held)";
+    for (size_t c = 0; c < step_fallback_nodes_.size(); ++c) {
+      const std::vector<int>& nodes = step_fallback_nodes_[c];
+      if (nodes.empty()) continue;
+      const bool held = tolerated && step_collisions_resolved_ && c < tolerated->size() &&
+                        std::all_of(nodes.begin(), nodes.end(), [&](int n) {
+                          return n < static_cast<int>((*tolerated)[c].size()) && (*tolerated)[c][n];
+                        });
+      if (held) {
+        if (tolerated_used) *tolerated_used = true;
+        continue;
+      }
+      return "the collision response of cloth " + std::to_string(c) + " needed a fallback (" +
+             std::to_string(nodes.size()) + " nodes moved rigidly or held)";
+    }
   if (step_correction_ > a.max_correction) {
     std::ostringstream what;
     what << "the collision response moved cloth " << step_correction_at_[0] << " node " << step_correction_at_[1] + 1
@@ -496,16 +508,61 @@ std::string Simulation::substep_problem(double dt) const {
   return "";
 }
 
+namespace {
+
+// Per cloth, a flag per node: the nodes within `rings` edges of `seeds` (per cloth, node indices).
+std::vector<std::vector<char>> nodes_within_rings(const std::vector<Cloth>& cloths,
+                                                  const std::vector<std::vector<int>>& seeds, int rings) {
+  std::vector<std::vector<char>> flags(cloths.size());
+  for (size_t c = 0; c < cloths.size(); ++c) {
+    const Mesh& mesh = cloths[c].mesh;
+    flags[c].assign(mesh.nodes.size(), 0);
+    std::vector<int> front;
+    for (int n : c < seeds.size() ? seeds[c] : std::vector<int>())
+      if (n >= 0 && n < static_cast<int>(mesh.nodes.size()) && !flags[c][n]) {
+        flags[c][n] = 1;
+        front.push_back(n);
+      }
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<int> next;
+      for (int n : front)
+        for (int e : mesh.nodes[n].edges)
+          for (int m : mesh.edges[e].n)
+            if (m != kNone && !flags[c][m]) {
+              flags[c][m] = 1;
+              next.push_back(m);
+            }
+      front = std::move(next);
+    }
+  }
+  return flags;
+}
+
+}  // namespace
+
 double Simulation::adaptive_dynamics_step(double start, double dt) {
   const AdaptiveStepSpec& a = scene_.adaptive_step;
   const DynamicsSnapshot snapshot = take_snapshot(cloths);
   PersistentFallback persistent(kPersistentFallbackLevels);
+  bool retaken = false;  // the step was retaken at its streak's level once already
+  int resume_level = 0;  // where refinement goes on if that attempt fails
   for (;;) {
+    // A fallback the step's start state forces (sim/persistent_fallback.hpp) is taken as at the finest substep,
+    // at the level where the streak began (finer substeps did not help), and held if it persists there.
+    const bool retake = persistent.persistent() && !retaken;
+    if (retake) {
+      retaken = true;
+      resume_level = substep_level_;
+      substep_level_ = persistent.streak_level();
+      steps_at_level_ = 0;
+    }
     const int substeps = 1 << substep_level_;
     const double h = dt / substeps;
-    // A fallback the step's start state forces (sim/persistent_fallback.hpp) is taken as at the finest substep.
     const bool smallest = !(0.5 * h >= a.min_step) || substep_level_ >= kMaxSubstepLevel;
     const bool finest = smallest || persistent.persistent();
+    std::vector<std::vector<char>> tolerated;
+    if (persistent.persistent()) tolerated = nodes_within_rings(cloths, persistent.streak_nodes(), kHeldFallbackRings);
+    bool held = false;
     std::string problem;
     int failed_substep = -1;
     std::vector<std::vector<int>> fallback_nodes(cloths.size());
@@ -517,7 +574,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
         move_obstacles(time_);
         failed_substep = k;
         dynamics_step(h, finest);
-        problem = substep_problem(h);
+        problem = substep_problem(h, persistent.persistent() ? &tolerated : nullptr, &held);
         for (size_t c = 0; c < step_fallback_nodes_.size() && c < cloths.size(); ++c)
           fallback_nodes[c].insert(fallback_nodes[c].end(), step_fallback_nodes_[c].begin(),
                                    step_fallback_nodes_[c].end());
@@ -525,10 +582,11 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
       // substep_problem names a fallback first whenever there was one (and fallbacks are rejected).
       if (!problem.empty())
         persistent.record_failure(failed_substep,
-                                  a.reject_fallbacks ? step_fallback_nodes_ : std::vector<std::vector<int>>());
+                                  a.reject_fallbacks ? step_fallback_nodes_ : std::vector<std::vector<int>>(),
+                                  substep_level_);
     } catch (const NumericalError& e) {
       problem = e.what();
-      persistent.record_failure(failed_substep, {});
+      persistent.record_failure(failed_substep, {}, substep_level_);
     }
     if (problem.empty()) {
       for (auto& nodes : fallback_nodes) {
@@ -537,6 +595,7 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
       }
       step_fallback_nodes_ = std::move(fallback_nodes);
       time_step_stats.record(substeps, h, substep_level_);
+      if (held) ++time_step_stats.held_steps;
       if (substep_level_ > 0 && ++steps_at_level_ >= a.grow_after) {
         --substep_level_;
         steps_at_level_ = 0;
@@ -555,7 +614,8 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
            << "; try a smaller min_step or time step";
       throw NumericalError(what.str());
     }
-    ++substep_level_;
+    // A retaken attempt that fails goes on refining from where the streak had got to.
+    substep_level_ = retake ? resume_level : substep_level_ + 1;
     steps_at_level_ = 0;
   }
 }

@@ -133,7 +133,8 @@ class Simulation {
   // dynamics substeps run, failed attempts redone with a smaller step (adaptive_time_step), the smallest substep
   // (s), the finest level (substeps = 2^level), and the last failure's cause.
   struct TimeStepStats {
-    int substeps = 0, retries = 0, level = 0;
+    // held_steps: steps taken with a persistent fallback held (Simulation::adaptive_dynamics_step).
+    int substeps = 0, retries = 0, level = 0, held_steps = 0;
     double smallest = 0;
     std::string cause;
     // A step taken as `count` substeps of h (s) at `level`.
@@ -156,6 +157,9 @@ class Simulation {
   // Attempts in a row whose first substep needs a fallback on shared nodes before the next attempt of the step
   // is taken as the finest (sim/persistent_fallback.hpp).
   static constexpr int kPersistentFallbackLevels = 3;
+  // A persistent fallback is held (the step accepted with it, if the response ended collision free) when every
+  // node it moved lies within this many edges of the nodes the streak fell back on.
+  static constexpr int kHeldFallbackRings = 2;
   // Fracture parameters (from the scene; tests and the ablations of tools/ change them).
   FractureParams fracture;
   // Whether the fracture module runs at the current time: enabled in the scene, and before passive_time
@@ -205,8 +209,11 @@ class Simulation {
   // the step's start one level finer whenever a substep fails (NumericalError, substep_problem). Returns the
   // last substep's size. Throws NumericalError when the step fails at min_step.
   double adaptive_dynamics_step(double start, double dt);
-  // Why the substep just taken fails adaptive_time_step's checks ("" if it does not).
-  std::string substep_problem(double dt) const;
+  // Why the substep just taken fails adaptive_time_step's checks ("" if it does not). With `tolerated` (per
+  // cloth, a flag per node), a fallback on flagged nodes only does not fail it if the response ended collision
+  // free; *tolerated_used then says whether there was one.
+  std::string substep_problem(double dt, const std::vector<std::vector<char>>* tolerated = nullptr,
+                              bool* tolerated_used = nullptr) const;
   // Plastic flow of every plastic cloth (module "plasticity"); marks changed cloths' elements dirty.
   void jitter_step();
   void plasticity_step(double dt);
@@ -238,6 +245,8 @@ class Simulation {
   // This step's nodes per cloth that the collision response moved by a fallback (fracture does not trust
   // their strain; FractureContext::untrusted_nodes).
   std::vector<std::vector<int>> step_fallback_nodes_;
+  // Whether the last collision response ended collision free (with or without a fallback).
+  bool step_collisions_resolved_ = true;
   int substep_level_ = 0;
   int steps_at_level_ = 0;
   // With adaptive_time_step: how far the last dynamics step's collision response moved a cloth node (m), and

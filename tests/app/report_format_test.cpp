@@ -127,6 +127,9 @@ TEST(FrameLog, TimeStepStatisticsWhenAdaptive) {
   EXPECT_EQ(t["level"].asInt(), 3);
   EXPECT_EQ(t["smallest"].asDouble(), 1.25e-3);
   EXPECT_EQ(t["cause"].asString(), r.retry_cause);  // quotes, backslashes and control characters escaped
+  EXPECT_FALSE(t.isMember("held"));  // only when a step held a persistent fallback
+  r.held_steps = 4;
+  EXPECT_EQ(parse(frame_log_line(r))["time_step"]["held"].asInt(), 4);
   r.retry_cause.clear();
   EXPECT_FALSE(parse(frame_log_line(r))["time_step"].isMember("cause"));
 }
