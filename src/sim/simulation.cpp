@@ -547,8 +547,9 @@ double Simulation::adaptive_dynamics_step(double start, double dt) {
   bool retaken = false;  // the step was retaken at its streak's level once already
   int resume_level = 0;  // where refinement goes on if that attempt fails
   for (;;) {
-    // A fallback the step's start state forces (sim/persistent_fallback.hpp) is taken as at the finest substep,
-    // at the level where the streak began (finer substeps did not help), and held if it persists there.
+    // A fallback that comes at one moment of the step whatever the substep's length (sim/persistent_fallback.hpp)
+    // is retaken as at the finest substep, at the level where the streak began (finer substeps did not help),
+    // and held if it persists there on the streak's nodes.
     const bool retake = persistent.persistent() && !retaken;
     if (retake) {
       retaken = true;
