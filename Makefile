@@ -14,7 +14,8 @@ WARN     := -Wall -Wextra -Wshadow=local -Wno-unused-parameter
 # Dependency headers are system headers: their own warnings (Eigen's false maybe-uninitialized) are not ours.
 BASEFLAGS := -std=c++17 $(WARN) -fopenmp -Isrc $(CHOLMOD_CFLAGS) \
              $(patsubst -I%,-isystem %,$(shell pkg-config --cflags $(PKGS) 2>/dev/null))
-LIBS     := $(shell pkg-config --libs $(PKGS) 2>/dev/null) $(CHOLMOD_LIBS) -fopenmp -lpthread
+# OSMesa gives its headers only: the renderer loads the library when it first renders (src/render/gl_api.hpp).
+LIBS     := $(filter-out -lOSMesa,$(shell pkg-config --libs $(PKGS) 2>/dev/null)) $(CHOLMOD_LIBS) -fopenmp -lpthread -ldl
 
 RELEASE_FLAGS := -O2 -DNDEBUG -DEIGEN_NO_DEBUG
 ASAN_FLAGS    := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined

@@ -1,6 +1,6 @@
 #include "render/render.hpp"
 
-#include <GL/gl.h>
+#include "render/gl_api.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -72,33 +72,33 @@ MeshArrays prepare(const RenderMesh& mesh, bool wireframe, bool highlight, const
 }
 
 void set_vertex_arrays(const MeshArrays& a, bool with_normals) {
-  glEnableClientState(GL_VERTEX_ARRAY);
-  glVertexPointer(3, GL_FLOAT, 0, a.positions.data());
+  gl().EnableClientState(GL_VERTEX_ARRAY);
+  gl().VertexPointer(3, GL_FLOAT, 0, a.positions.data());
   if (with_normals) {
-    glEnableClientState(GL_NORMAL_ARRAY);
-    glNormalPointer(GL_FLOAT, 0, a.normals.data());
+    gl().EnableClientState(GL_NORMAL_ARRAY);
+    gl().NormalPointer(GL_FLOAT, 0, a.normals.data());
   } else {
-    glDisableClientState(GL_NORMAL_ARRAY);
+    gl().DisableClientState(GL_NORMAL_ARRAY);
   }
 }
 
 void draw_triangles(const MeshArrays& a, bool with_normals) {
   if (a.triangles.empty()) return;
   set_vertex_arrays(a, with_normals);
-  glDrawElements(GL_TRIANGLES, GLsizei(a.triangles.size()), GL_UNSIGNED_INT, a.triangles.data());
+  gl().DrawElements(GL_TRIANGLES, GLsizei(a.triangles.size()), GL_UNSIGNED_INT, a.triangles.data());
 }
 
 void draw_lines(const MeshArrays& a, const std::vector<GLuint>& lines) {
   if (lines.empty()) return;
   set_vertex_arrays(a, false);
-  glDrawElements(GL_LINES, GLsizei(lines.size()), GL_UNSIGNED_INT, lines.data());
+  gl().DrawElements(GL_LINES, GLsizei(lines.size()), GL_UNSIGNED_INT, lines.data());
 }
 
 void set_material(GLenum face, const GLfloat colour[4], GLfloat specular, GLfloat shininess) {
   const GLfloat spec[4] = {specular, specular, specular, 1};
-  glMaterialfv(face, GL_AMBIENT_AND_DIFFUSE, colour);
-  glMaterialfv(face, GL_SPECULAR, spec);
-  glMaterialf(face, GL_SHININESS, shininess);
+  gl().Materialfv(face, GL_AMBIENT_AND_DIFFUSE, colour);
+  gl().Materialfv(face, GL_SPECULAR, spec);
+  gl().Materialf(face, GL_SHININESS, shininess);
 }
 
 void set_light(GLenum light, const Vec3& toward, GLfloat diffuse, GLfloat specular) {
@@ -106,28 +106,28 @@ void set_light(GLenum light, const Vec3& toward, GLfloat diffuse, GLfloat specul
   const GLfloat zero[4] = {0, 0, 0, 1};
   const GLfloat dif[4] = {diffuse, diffuse, diffuse, 1};
   const GLfloat spec[4] = {specular, specular, specular, 1};
-  glEnable(light);
-  glLightfv(light, GL_POSITION, position);  // transformed by the current (view) matrix: world direction
-  glLightfv(light, GL_AMBIENT, zero);
-  glLightfv(light, GL_DIFFUSE, dif);
-  glLightfv(light, GL_SPECULAR, spec);
+  gl().Enable(light);
+  gl().Lightfv(light, GL_POSITION, position);  // transformed by the current (view) matrix: world direction
+  gl().Lightfv(light, GL_AMBIENT, zero);
+  gl().Lightfv(light, GL_DIFFUSE, dif);
+  gl().Lightfv(light, GL_SPECULAR, spec);
 }
 
 void draw_background() {
-  glMatrixMode(GL_PROJECTION);
-  glLoadIdentity();
-  glMatrixMode(GL_MODELVIEW);
-  glLoadIdentity();
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_LIGHTING);
-  glBegin(GL_QUADS);
-  glColor3fv(kBackgroundBottom);
-  glVertex2f(-1, -1);
-  glVertex2f(1, -1);
-  glColor3fv(kBackgroundTop);
-  glVertex2f(1, 1);
-  glVertex2f(-1, 1);
-  glEnd();
+  gl().MatrixMode(GL_PROJECTION);
+  gl().LoadIdentity();
+  gl().MatrixMode(GL_MODELVIEW);
+  gl().LoadIdentity();
+  gl().Disable(GL_DEPTH_TEST);
+  gl().Disable(GL_LIGHTING);
+  gl().Begin(GL_QUADS);
+  gl().Color3fv(kBackgroundBottom);
+  gl().Vertex2f(-1, -1);
+  gl().Vertex2f(1, -1);
+  gl().Color3fv(kBackgroundTop);
+  gl().Vertex2f(1, 1);
+  gl().Vertex2f(-1, 1);
+  gl().End();
 }
 
 double smoothstep(double edge0, double edge1, double x) {
@@ -146,7 +146,7 @@ void draw_ground(const Stage& stage) {
   const double ca = stage.ground_center.dot(axes.side), cb = stage.ground_center.dot(axes.front);
   const long i0 = long(std::floor((ca - radius) / cell)), i1 = long(std::ceil((ca + radius) / cell));
   const long j0 = long(std::floor((cb - radius) / cell)), j1 = long(std::ceil((cb + radius) / cell));
-  glBegin(GL_QUADS);
+  gl().Begin(GL_QUADS);
   for (long i = i0; i < i1; ++i)
     for (long j = j0; j < j1; ++j) {
       const GLfloat* c = ((i + j) & 1) ? kGroundDark : kGroundLight;
@@ -154,35 +154,35 @@ void draw_ground(const Stage& stage) {
       auto corner = [&](long ii, long jj) {
         const double a = double(ii) * cell, b = double(jj) * cell;
         const double fade = 1 - smoothstep(0.35 * radius, radius, std::hypot(a - ca, b - cb));
-        glColor4f(c[0], c[1], c[2], GLfloat(fade));
+        gl().Color4f(c[0], c[1], c[2], GLfloat(fade));
         const Vec3 p = origin + a * axes.side + b * axes.front;
-        glVertex3d(p.x(), p.y(), p.z());
+        gl().Vertex3d(p.x(), p.y(), p.z());
       };
       corner(i, j);
       corner(i + 1, j);
       corner(i + 1, j + 1);
       corner(i, j + 1);
     }
-  glEnd();
+  gl().End();
 }
 
 // Resets the state a previous frame may have left and paints the background gradient.
 void clear_to_background(int width, int height, bool multisampled) {
-  glViewport(0, 0, width, height);
-  glDisable(GL_SCISSOR_TEST);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(GL_TRUE);
-  glStencilMask(0xff);
-  glClearColor(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2], 1);
-  glClearDepth(1);
-  glClearStencil(0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-  if (multisampled) glEnable(GL_MULTISAMPLE);
-  glShadeModel(GL_SMOOTH);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_STENCIL_TEST);
-  glDisable(GL_BLEND);
-  glDisable(GL_POLYGON_OFFSET_FILL);
+  gl().Viewport(0, 0, width, height);
+  gl().Disable(GL_SCISSOR_TEST);
+  gl().ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl().DepthMask(GL_TRUE);
+  gl().StencilMask(0xff);
+  gl().ClearColor(kBackgroundTop[0], kBackgroundTop[1], kBackgroundTop[2], 1);
+  gl().ClearDepth(1);
+  gl().ClearStencil(0);
+  gl().Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  if (multisampled) gl().Enable(GL_MULTISAMPLE);
+  gl().ShadeModel(GL_SMOOTH);
+  gl().Disable(GL_CULL_FACE);
+  gl().Disable(GL_STENCIL_TEST);
+  gl().Disable(GL_BLEND);
+  gl().Disable(GL_POLYGON_OFFSET_FILL);
   draw_background();
 }
 
@@ -196,12 +196,12 @@ Mat4 load_camera(const Camera& camera, const Stage& stage, const Eigen::AlignedB
   const double z_near = std::max(z_far * 1e-3, distance - 1.05 * reach);
   const Mat4 projection = projection_matrix(camera, aspect, z_near, z_far);
   const Mat4 view = view_matrix(camera);
-  glMatrixMode(GL_PROJECTION);
-  glLoadMatrixd(projection.data());
-  glMatrixMode(GL_MODELVIEW);
-  glLoadMatrixd(view.data());
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
+  gl().MatrixMode(GL_PROJECTION);
+  gl().LoadMatrixd(projection.data());
+  gl().MatrixMode(GL_MODELVIEW);
+  gl().LoadMatrixd(view.data());
+  gl().Enable(GL_DEPTH_TEST);
+  gl().DepthFunc(GL_LEQUAL);
   return view;
 }
 
@@ -209,12 +209,12 @@ Mat4 load_camera(const Camera& camera, const Stage& stage, const Eigen::AlignedB
 // loaded (light directions are given in world space).
 void set_lights(const Stage& stage) {
   const GLfloat ambient[4] = {0.30f, 0.30f, 0.30f, 1};
-  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
-  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
-  glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
+  gl().LightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  gl().LightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+  gl().LightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
   set_light(GL_LIGHT0, stage.key_light, 0.72f, 0.25f);
   set_light(GL_LIGHT1, stage.fill_light, 0.30f, 0.0f);
-  glColor4f(1, 1, 1, 1);
+  gl().Color4f(1, 1, 1, 1);
 }
 
 // Darkens the ground and obstacle pixels (stencil 1) covered by the meshes flattened onto the ground along the
@@ -222,21 +222,21 @@ void set_lights(const Stage& stage) {
 // ground plane, while anything standing in front of the plane still hides it.
 void draw_shadows(const Stage& stage, const Mat4& view,
                   std::initializer_list<const std::vector<MeshArrays>*> casters) {
-  glStencilFunc(GL_EQUAL, 1, 0xff);
-  glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-  glDepthMask(GL_FALSE);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-  glColor4fv(kShadow);
-  glPolygonOffset(-1, -4);
+  gl().StencilFunc(GL_EQUAL, 1, 0xff);
+  gl().StencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+  gl().DepthMask(GL_FALSE);
+  gl().Enable(GL_BLEND);
+  gl().BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  gl().Color4fv(kShadow);
+  gl().PolygonOffset(-1, -4);
   const Mat4 shadow = view * planar_shadow_matrix(stage.up, stage.ground_level, stage.key_light);
-  glLoadMatrixd(shadow.data());
+  gl().LoadMatrixd(shadow.data());
   for (const auto* list : casters)
     for (const MeshArrays& a : *list)
       if (a.casts_shadow) draw_triangles(a, false);
-  glLoadMatrixd(view.data());
-  glDisable(GL_BLEND);
-  glDepthMask(GL_TRUE);
+  gl().LoadMatrixd(view.data());
+  gl().Disable(GL_BLEND);
+  gl().DepthMask(GL_TRUE);
 }
 
 // Wireframe and highlighted edges of the cloths. Lines sit exactly on the surfaces, which were pushed back by
@@ -244,22 +244,22 @@ void draw_shadows(const Stage& stage, const Mat4& view,
 void draw_edges(const std::vector<MeshArrays>& cloths, const RenderOptions& options, int image_height) {
   const GLfloat line_scale = GLfloat(std::max(1.0, image_height / 720.0));
   if (options.wireframe) {
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glDepthMask(GL_FALSE);
-    glLineWidth(line_scale);
-    glColor4fv(kWire);
+    gl().Enable(GL_BLEND);
+    gl().BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    gl().DepthMask(GL_FALSE);
+    gl().LineWidth(line_scale);
+    gl().Color4fv(kWire);
     for (const MeshArrays& a : cloths) draw_lines(a, a.wire);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
+    gl().DepthMask(GL_TRUE);
+    gl().Disable(GL_BLEND);
   }
   if (options.highlight_edges) {
-    glLineWidth(2 * line_scale);
-    glColor4fv(kHighlight);
+    gl().LineWidth(2 * line_scale);
+    gl().Color4fv(kHighlight);
     for (const MeshArrays& a : cloths) draw_lines(a, a.highlight);
   }
-  glDisableClientState(GL_VERTEX_ARRAY);
-  glDisableClientState(GL_NORMAL_ARRAY);
+  gl().DisableClientState(GL_VERTEX_ARRAY);
+  gl().DisableClientState(GL_NORMAL_ARRAY);
 }
 
 std::string gl_error_text(GLenum error) {
@@ -306,36 +306,36 @@ void Renderer::render(const std::vector<RenderMesh>& cloths, const std::vector<R
   set_lights(stage);
 
   // Ground and obstacles mark the stencil buffer: shadows are drawn only there, once per pixel.
-  glEnable(GL_STENCIL_TEST);
-  glStencilFunc(GL_ALWAYS, 1, 0xff);
-  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-  glEnable(GL_POLYGON_OFFSET_FILL);
+  gl().Enable(GL_STENCIL_TEST);
+  gl().StencilFunc(GL_ALWAYS, 1, 0xff);
+  gl().StencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  gl().Enable(GL_POLYGON_OFFSET_FILL);
   if (options.ground) {
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glPolygonOffset(4, 16);  // behind everything resting on it
+    gl().Enable(GL_BLEND);
+    gl().BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    gl().PolygonOffset(4, 16);  // behind everything resting on it
     draw_ground(stage);
-    glDisable(GL_BLEND);
+    gl().Disable(GL_BLEND);
   }
-  glEnable(GL_LIGHTING);
+  gl().Enable(GL_LIGHTING);
   set_material(GL_FRONT_AND_BACK, kObstacle, 0.12f, 20);
-  glPolygonOffset(2, 4);  // behind cloth lying on them
+  gl().PolygonOffset(2, 4);  // behind cloth lying on them
   for (const MeshArrays& a : obstacle_arrays) draw_triangles(a, true);
-  glDisable(GL_LIGHTING);
+  gl().Disable(GL_LIGHTING);
   if (options.ground && options.shadows) draw_shadows(stage, view, {&obstacle_arrays, &cloth_arrays});
-  glDisable(GL_STENCIL_TEST);
+  gl().Disable(GL_STENCIL_TEST);
 
-  glEnable(GL_LIGHTING);
+  gl().Enable(GL_LIGHTING);
   set_material(GL_FRONT, kClothFront, 0.15f, 28);
   set_material(GL_BACK, kClothBack, 0.10f, 28);
-  glPolygonOffset(1, 1);  // lets the lines drawn next win the depth test
+  gl().PolygonOffset(1, 1);  // lets the lines drawn next win the depth test
   for (const MeshArrays& a : cloth_arrays) draw_triangles(a, true);
-  glDisable(GL_LIGHTING);
-  glDisable(GL_POLYGON_OFFSET_FILL);
+  gl().Disable(GL_LIGHTING);
+  gl().Disable(GL_POLYGON_OFFSET_FILL);
   draw_edges(cloth_arrays, options, height_);
 
   context_->end_frame();
-  const GLenum error = glGetError();
+  const GLenum error = gl().GetError();
   if (error != GL_NO_ERROR) throw std::runtime_error("renderer: OpenGL error " + gl_error_text(error));
 
   const size_t row = size_t(width_) * 4;
