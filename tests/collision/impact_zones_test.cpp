@@ -57,6 +57,17 @@ int intersections(const ContactGeometry& g, int mesh_a, int mesh_b) {
   return n;
 }
 
+// A mesh from a recorded impact zone: per node {x0 (3), x1 (3), mass}, the start positions as the rest shape.
+Mesh recorded_zone_mesh(const std::vector<std::array<double, 7>>& nodes, const std::vector<std::array<int, 3>>& faces) {
+  std::vector<Vec3> x0, x1;
+  for (const auto& n : nodes) x0.emplace_back(n[0], n[1], n[2]), x1.emplace_back(n[3], n[4], n[5]);
+  std::vector<int> vert_node(nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i) vert_node[i] = static_cast<int>(i);
+  Mesh m = Mesh::from_triangles(x1, x0, vert_node, faces);
+  for (size_t i = 0; i < nodes.size(); ++i) m.nodes[i].x0 = x0[i], m.nodes[i].x = x1[i], m.nodes[i].mass = nodes[i][6];
+  return m;
+}
+
 TEST(ImpactZones, SheetPassingThroughPlateStopsAtTheGap) {
   Mesh s = sheet(4, 0.2, 0.1, 0.15, 1e-3), p = plate(0);
   for (Node& n : s.nodes) {
@@ -374,12 +385,7 @@ TEST(ImpactZones, RecordedStackedCrackLipsAreResolvedWithoutFallback) {
        0.090095178596230119, -0.082523682423757599, 0.00732790902805065, 6.2181475584856551e-05},
   };
   const std::vector<std::array<int, 3>> faces{{5, 1, 6}, {0, 1, 5}, {3, 7, 8}, {8, 4, 3}, {3, 4, 2}, {4, 9, 10}, {11, 9, 4}, {4, 8, 11}};
-  std::vector<Vec3> x0, x1;
-  for (const auto& n : nodes) x0.emplace_back(n[0], n[1], n[2]), x1.emplace_back(n[3], n[4], n[5]);
-  std::vector<int> vert_node(nodes.size());
-  for (size_t i = 0; i < nodes.size(); ++i) vert_node[i] = static_cast<int>(i);
-  Mesh m = Mesh::from_triangles(x1, x0, vert_node, faces);
-  for (size_t i = 0; i < nodes.size(); ++i) m.nodes[i].x0 = x0[i], m.nodes[i].x = x1[i], m.nodes[i].mass = nodes[i][6];
+  Mesh m = recorded_zone_mesh(nodes, faces);
   ContactGeometry g;
   build_contact_geometry({{&m, true}}, ContactStage::kAfterStep, 5e-3, g);
   ImpactZoneParams p = params();
@@ -464,12 +470,7 @@ TEST(ImpactZones, ZoneHeldAtItsStartTakesInTheNodesOfEachPairStillHittingIt) {
       {10, 5, 13}, {13, 9, 10}, {7, 9, 13}, {14, 8, 9}, {14, 9, 12}, {4, 15, 6}, {15, 0, 6}, {17, 1, 2}, {2, 16, 17},
       {19, 18, 1}, {19, 1, 17}, {20, 1, 18}, {21, 12, 11}, {12, 21, 14}, {21, 11, 22}, {11, 1, 23}
   };
-  std::vector<Vec3> x0, x1;
-  for (const auto& n : nodes) x0.emplace_back(n[0], n[1], n[2]), x1.emplace_back(n[3], n[4], n[5]);
-  std::vector<int> vert_node(nodes.size());
-  for (size_t i = 0; i < nodes.size(); ++i) vert_node[i] = static_cast<int>(i);
-  Mesh m = Mesh::from_triangles(x1, x0, vert_node, faces);
-  for (size_t i = 0; i < nodes.size(); ++i) m.nodes[i].x0 = x0[i], m.nodes[i].x = x1[i], m.nodes[i].mass = nodes[i][6];
+  Mesh m = recorded_zone_mesh(nodes, faces);
   ContactGeometry g;
   build_contact_geometry({{&m, true}}, ContactStage::kAfterStep, 5e-5 / 32, g);
   ImpactZoneParams p = params();
