@@ -178,8 +178,8 @@ std::vector<PrimitivePair> brute_candidates(const ContactGeometry& g, double mar
 struct TwoMeshes {
   Mesh sheet, plate;
   ContactGeometry g;
-  explicit TwoMeshes(unsigned seed) {
-    sheet = testing::make_grid(8, 8, 1, 1, testing::Diagonal::kAlternating);
+  explicit TwoMeshes(unsigned seed, int cells = 8) {
+    sheet = testing::make_grid(cells, cells, 1, 1, testing::Diagonal::kAlternating);
     plate = testing::make_grid(3, 3, 1.2, 1.2, testing::Diagonal::kForward, -0.1, -0.1);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> U(-1, 1);
@@ -207,6 +207,23 @@ TEST(Candidates, MatchBruteForceForSweptAndStaticBoxes) {
       EXPECT_TRUE(found == expected) << "seed " << seed << " swept " << swept;
       EXPECT_FALSE(found.empty());
     }
+  }
+}
+
+// Thousands of candidates: the search sorts them by counting (collision/candidates.cpp, sort_unique), not by
+// std::sort, which the small sheet above keeps to.
+TEST(Candidates, MatchBruteForceWithThousandsOfCandidates) {
+  TwoMeshes m(5, 20);
+  for (bool swept : {true, false}) {
+    BvhCache cache;
+    CandidateOptions options;
+    options.margin = 0.08;
+    options.swept = swept;
+    const auto found = find_candidates(m.g, cache, options);
+    const auto expected = brute_candidates(m.g, options.margin, swept);
+    EXPECT_GE(found.size(), 4096u) << "swept " << swept;
+    EXPECT_EQ(found.size(), expected.size()) << "swept " << swept;
+    EXPECT_TRUE(found == expected) << "swept " << swept;
   }
 }
 
