@@ -15,6 +15,7 @@ namespace {
 constexpr int kExitSuccess = 0;
 constexpr int kExitInternal = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitEnvironment = 4;
 constexpr int kExitNumerical = 3;
 
 void print_error(const Console& console, const std::string& message) {
@@ -78,7 +79,7 @@ std::string general_help() {
       "  --version   print the version\n"
       "\n"
       "Example: arcsim simulate conf/demo.json out/demo\n"
-      "Exit codes: 0 success, 2 bad input, 3 numerical failure, 1 internal error.\n";
+      "Exit codes: 0 success, 2 bad input, 3 numerical failure, 4 missing system library, 1 internal error.\n";
   return text;
 }
 
@@ -91,6 +92,9 @@ int run_command_line(const std::vector<std::string>& args, const Console& consol
   } catch (const NumericalError& e) {
     print_error(console, std::string("numerical failure: ") + e.what());
     return kExitNumerical;
+  } catch (const EnvironmentError& e) {
+    print_error(console, e.what());
+    return kExitEnvironment;
   } catch (const std::exception& e) {
     print_error(console, std::string("internal error: ") + e.what());
     return kExitInternal;

@@ -18,4 +18,11 @@ struct NumericalError : std::runtime_error {
   explicit NumericalError(const std::string& what) : std::runtime_error(what) {}
 };
 
+// The machine lacks something the command needs (a system library loaded at run time, such as libOSMesa for
+// `replay`): neither the input's fault nor a bug. One line naming what is missing and the Debian package that
+// provides it. Exit code 4.
+struct EnvironmentError : std::runtime_error {
+  explicit EnvironmentError(const std::string& what) : std::runtime_error(what) {}
+};
+
 }  // namespace arcsim

@@ -2,8 +2,9 @@
 
 #include <dlfcn.h>
 
-#include <stdexcept>
 #include <string>
+
+#include "math/errors.hpp"
 
 namespace arcsim {
 
@@ -19,7 +20,7 @@ void* open_library() {
     const char* why = dlerror();
     errors += std::string(errors.empty() ? "" : "; ") + (why ? why : name);
   }
-  throw std::runtime_error("renderer: cannot load OSMesa (" + errors + "); install Debian's libosmesa6");
+  throw EnvironmentError("renderer: cannot load OSMesa (" + errors + "); install Debian's libosmesa6");
 }
 
 GlApi load() {
@@ -27,7 +28,7 @@ GlApi load() {
   GlApi api;
   auto find = [&](const char* symbol) {
     void* address = dlsym(library, symbol);
-    if (!address) throw std::runtime_error(std::string("renderer: libOSMesa has no ") + symbol);
+    if (!address) throw EnvironmentError(std::string("renderer: libOSMesa has no ") + symbol);
     return address;
   };
 #define ARCSIM_LOAD_OSMESA(name) \
@@ -39,7 +40,7 @@ GlApi load() {
   auto find_gl = [&](const char* symbol) {
     if (void* address = dlsym(library, symbol)) return address;
     if (auto address = api.OSMesaGetProcAddress(symbol)) return reinterpret_cast<void*>(address);
-    throw std::runtime_error(std::string("renderer: libOSMesa has no ") + symbol);
+    throw EnvironmentError(std::string("renderer: libOSMesa has no ") + symbol);
   };
 #define ARCSIM_LOAD_GL(name) api.name = reinterpret_cast<decltype(api.name)>(find_gl("gl" #name));
   ARCSIM_GL_FUNCTIONS(ARCSIM_LOAD_GL)

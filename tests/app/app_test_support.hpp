@@ -100,14 +100,17 @@ struct RunResult {
   std::string out, err;
 };
 
-// Runs the binary with `args` in the folder `cwd` (the test's working directory if empty), stdin closed.
-inline RunResult run_arcsim(const std::vector<std::string>& args, const std::string& cwd = "") {
+// Runs the binary with `args` in the folder `cwd` (the test's working directory if empty), stdin closed, with
+// the environment variables `env` ("NAME=value") added.
+inline RunResult run_arcsim(const std::vector<std::string>& args, const std::string& cwd = "",
+                            const std::vector<std::string>& env = {}) {
   static std::atomic<int> counter{0};
   const std::string stem = (fs::temp_directory_path() / ("arcsim-app-run-" + std::to_string(::getpid()) + "-" +
                                                          std::to_string(counter++)))
                                .string();
   std::string command;
   if (!cwd.empty()) command += "cd " + shell_quote(cwd) + " && ";
+  for (const std::string& e : env) command += "export " + shell_quote(e) + " && ";
   command += shell_quote(binary());
   for (const std::string& a : args) command += " " + shell_quote(a);
   command += " </dev/null >" + shell_quote(stem + ".out") + " 2>" + shell_quote(stem + ".err");

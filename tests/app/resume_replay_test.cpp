@@ -376,5 +376,24 @@ TEST(Replay, RendersEverySavedFrameToPng) {
   EXPECT_EQ(run_arcsim({"replay", dir / "png", "--quiet"}).exit_code, 2);
 }
 
+// A machine without a loadable libOSMesa: replay says so in one line naming the package, exits with 4 (a missing
+// system library, not an internal error), and writes no image. The loader finds broken stand-ins first
+// (LD_LIBRARY_PATH is searched before the system's folders).
+TEST(Replay, WithoutALoadableOSMesaSaysWhichPackageToInstall) {
+  if (binary().empty()) GTEST_SKIP() << "ARCSIM_BIN not set";
+  TempFolder dir;
+  const std::string scene = resume_scene(dir);
+  ASSERT_EQ(run_arcsim({"simulate", scene, dir / "run", "--quiet", "--end-frame", "1"}).exit_code, 0);
+  dir.write("libs/libOSMesa.so.8", "not a library");
+  dir.write("libs/libOSMesa.so", "not a library");
+  const RunResult r =
+      run_arcsim({"replay", dir / "run", dir / "png", "--quiet"}, "", {"LD_LIBRARY_PATH=" + dir / "libs"});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("arcsim: renderer: cannot load OSMesa", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("libosmesa6"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "png/00000.png"));
+}
+
 }  // namespace
 }  // namespace arcsim
