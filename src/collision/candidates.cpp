@@ -5,6 +5,8 @@
 #include <cstring>
 #include <type_traits>
 
+#include "math/counting_sort.hpp"
+
 namespace arcsim {
 
 std::array<int, 4> pair_nodes(const ContactGeometry& g, const PrimitivePair& p) {
@@ -213,31 +215,18 @@ std::vector<std::pair<int, int>> overlapping_faces(const ContactGeometry& g, con
   return face_pairs;
 }
 
-// Sorts pairs[first, end) as std::sort does (by kind, a, b) and drops duplicates. Counting sort by (kind, a), every
-// a in [0, a_count), then each (small) bucket by b: a proximity search sorts ~10^5-10^6 pairs, and std::sort took
-// 4% of flag.json's wall. Short ranges, and any a out of range, go to std::sort.
+// Sorts pairs[first, end) as std::sort does (by kind, a, b) and drops duplicates, by counting on (kind, a), every
+// a in [0, a_count): a proximity search sorts ~10^5-10^6 pairs, and std::sort took 4% of flag.json's wall.
 void sort_unique(std::vector<PrimitivePair>& pairs, size_t first, int a_count) {
-  const auto begin = pairs.begin() + static_cast<std::ptrdiff_t>(first);
-  const size_t count = pairs.size() - first;
-  const bool in_range = std::all_of(begin, pairs.end(), [&](const PrimitivePair& p) { return p.a >= 0 && p.a < a_count; });
-  if (count < 4096 || !in_range) {
-    std::sort(begin, pairs.end());
-  } else {
-    const auto key = [&](const PrimitivePair& p) { return static_cast<size_t>(p.kind) * a_count + p.a; };
-    const size_t keys = 3 * static_cast<size_t>(a_count);
-    std::vector<int> start(keys + 1, 0);
-    for (auto it = begin; it != pairs.end(); ++it) ++start[key(*it) + 1];
-    for (size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
-    std::vector<PrimitivePair> sorted(count);
-    {
-      std::vector<int> next(start.begin(), start.end() - 1);
-      for (auto it = begin; it != pairs.end(); ++it) sorted[next[key(*it)]++] = *it;
-    }
-    for (size_t k = 0; k < keys; ++k)
-      if (start[k + 1] - start[k] > 1) std::sort(sorted.begin() + start[k], sorted.begin() + start[k + 1]);
-    std::copy(sorted.begin(), sorted.end(), begin);
-  }
-  pairs.erase(std::unique(begin, pairs.end()), pairs.end());
+  const size_t a_keys = static_cast<size_t>(std::max(a_count, 0));
+  counting_sort_unique(
+      pairs, first, 3 * a_keys,
+      [&](const PrimitivePair& p) {
+        // An a out of range has no key (-1): the whole range then goes to std::sort.
+        if (p.a < 0 || static_cast<size_t>(p.a) >= a_keys) return -1L;
+        return static_cast<long>(p.kind) * static_cast<long>(a_keys) + p.a;
+      },
+      4096);
 }
 
 // The static candidates of the face pairs (passing `passes` when given), sorted and unique. Ownership makes

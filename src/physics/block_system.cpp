@@ -6,6 +6,8 @@
 #include <atomic>
 #include <chrono>
 
+#include "math/counting_sort.hpp"
+
 namespace arcsim {
 
 namespace {
@@ -17,21 +19,7 @@ double seconds_between(std::chrono::steady_clock::time_point a, std::chrono::ste
 }  // namespace
 
 void sort_unique_pairs(std::vector<std::pair<int, int>>& pairs, int key_count) {
-  const bool in_range = std::all_of(pairs.begin(), pairs.end(),
-                                    [&](const auto& p) { return p.first >= 0 && p.first < key_count; });
-  if (!in_range) {
-    std::sort(pairs.begin(), pairs.end());
-  } else {
-    std::vector<int> start(key_count + 1, 0);
-    for (const auto& p : pairs) ++start[p.first + 1];
-    for (int k = 0; k < key_count; ++k) start[k + 1] += start[k];
-    std::vector<int> next(start.begin(), start.end() - 1);
-    std::vector<std::pair<int, int>> sorted(pairs.size());
-    for (const auto& p : pairs) sorted[next[p.first]++] = p;
-    for (int k = 0; k < key_count; ++k) std::sort(sorted.begin() + start[k], sorted.begin() + start[k + 1]);
-    pairs.swap(sorted);
-  }
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  counting_sort_unique(pairs, 0, static_cast<size_t>(std::max(key_count, 0)), [](const auto& p) { return p.first; });
 }
 
 void BlockPattern::build(int node_count, std::vector<std::pair<int, int>> pairs) {
