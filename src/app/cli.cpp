@@ -15,8 +15,8 @@ namespace {
 constexpr int kExitSuccess = 0;
 constexpr int kExitInternal = 1;
 constexpr int kExitBadInput = 2;
-constexpr int kExitEnvironment = 4;
 constexpr int kExitNumerical = 3;
+constexpr int kExitEnvironment = 4;
 
 void print_error(const Console& console, const std::string& message) {
   console.err << kProgramName << ": " << one_line(message) << '\n' << std::flush;

@@ -8,8 +8,9 @@ namespace arcsim {
 // frees and allocates the same large arrays again (CHOLMOD's factor after each new symbolic analysis, the
 // system's blocks after a remesh), and with glibc's defaults (mappings from 128 KiB to 32 MiB, trimming above
 // 128 KiB) each one came back as fresh pages that fault on first touch: 8% of flag.json's wall went to page
-// faults in CHOLMOD's clearing of its factor (docs/benchmarks.md, "Page faults of freed arrays"). The cost is a
-// process that keeps its peak heap; flag.json's peak resident set did not grow. Call once, first thing in main.
+// faults in CHOLMOD's clearing of its factor (docs/benchmarks.md, "flag.json's page faults and candidate sort").
+// The cost is a process that keeps its peak heap (tshirt.json's peak resident set: +5%). Call once, first thing
+// in main.
 void keep_freed_memory_in_heap();
 
 }  // namespace arcsim
