@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <array>
 #include <unordered_set>
 #include <utility>
 
@@ -190,12 +190,6 @@ class Remesher {
     return true;
   }
 
-  bool node_inside(int n) const {
-    for (int f : m_.node_faces(n))
-      if (!is_active(f)) return false;
-    return true;
-  }
-
   std::vector<int> active_edges() const {
     std::vector<int> edges;
     for (size_t e = 0; e < m_.edges.size(); ++e)
@@ -296,23 +290,41 @@ class Remesher {
     const Edge& edge = m_.edges[e];
     const int gone = edge.n[remove_side], keep = edge.n[1 - remove_side];
     const Node& g = m_.nodes[gone];
-    if (g.preserve || g.label != 0 || !node_inside(gone)) return false;
-    std::map<int, int> vert_map;
+    if (g.preserve || g.label != 0) return false;
+    const std::vector<int> fan = m_.node_faces(gone);
+    for (int f : fan)
+      if (!is_active(f)) return false;
+    // The removed node's vert in each face of the edge, and the kept node's vert that replaces it.
+    std::array<std::pair<int, int>, 2> vert_map{{{kNone, kNone}, {kNone, kNone}}};
     for (int s = 0; s < 2; ++s)
-      if (edge.f[s] != kNone) vert_map[vert_at(m_, edge.f[s], gone)] = vert_at(m_, edge.f[s], keep);
+      if (edge.f[s] != kNone) vert_map[s] = {vert_at(m_, edge.f[s], gone), vert_at(m_, edge.f[s], keep)};
+    const auto replacement = [&](int vert) {  // the second face's pair first, as a map written in order
+      for (int s = 1; s >= 0; --s)
+        if (vert_map[s].first == vert && vert != kNone) return vert_map[s].second;
+      return kNone;
+    };
+    // The new edges' metric lengths first: in a mesh that meets its sizing nearly every edge is shorter than 1
+    // and so a candidate, and this is the test that turns most of them down (the checks are independent, so
+    // their order does not change the answer).
+    for (int f : fan) {
+      if (f == edge.f[0] || f == edge.f[1]) continue;
+      const Face& face = m_.faces[f];
+      const int c = m_.corner_of_node(f, gone);
+      const int kept_vert = replacement(face.v[c]);
+      if (kept_vert == kNone) return false;
+      for (int k = 1; k <= 2; ++k)
+        if (vert_pair_metric_length(m_, kept_vert, face.v[(c + k) % 3]) > kCollapseMetricLimit) return false;
+    }
     if (m_.is_boundary_node(gone) && !boundary_node_on_chord(gone)) return false;
     const Vec3& x_keep = m_.nodes[keep].x;
     double gone_to_surface = kInfinity, gone_to_rest_surface = kInfinity;  // m
-    const std::vector<int> fan = m_.node_faces(gone);
     const RestSidePositions rest(m_, o_.max_surface_change > 0 ? &materials_ : nullptr, fan);
     for (int f : fan) {
       if (f == edge.f[0] || f == edge.f[1]) continue;
       const Face& face = m_.faces[f];
       const int c = m_.corner_of_node(f, gone);
-      const auto it = vert_map.find(face.v[c]);
-      if (it == vert_map.end()) return false;
       std::array<int, 3> nv = face.v;
-      nv[c] = it->second;
+      nv[c] = replacement(face.v[c]);
       const Vec3 &u0 = m_.verts[nv[0]].u, &u1 = m_.verts[nv[1]].u, &u2 = m_.verts[nv[2]].u;
       const Vec3 &o0 = m_.verts[face.v[0]].u, &o1 = m_.verts[face.v[1]].u, &o2 = m_.verts[face.v[2]].u;
       const double aspect = triangle_aspect(u0, u1, u2), old_aspect = triangle_aspect(o0, o1, o2);
@@ -325,8 +337,6 @@ class Remesher {
       x[c] = x_keep;
       const Vec3 wn = world_cross(x[0], x[1], x[2]), old_wn = world_cross(old_x[0], old_x[1], old_x[2]);
       if (wn.dot(old_wn) <= 0 && old_wn.norm() > 0) return false;
-      for (int k = 1; k <= 2; ++k)
-        if (vert_pair_metric_length(m_, it->second, nv[(c + k) % 3]) > kCollapseMetricLimit) return false;
       gone_to_surface = std::min(gone_to_surface, vertex_face_closest(g.x, x[0], x[1], x[2]).distance);
       if (rest.plastic()) {
         // The same face in the plastic shape: its corners' embedded positions, the removed one replaced by keep.
