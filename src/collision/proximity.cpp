@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "collision/distance.hpp"
 
@@ -25,12 +24,18 @@ double friction_damping(double mu, double normal_force, double tangential_speed,
 namespace {
 
 // Which element slot a pair competes for: the nearest partner per (element, side) wins.
-enum SlotKind { kNodeSlot, kEdgeSlot, kFaceSlot, kNodeLipSlot, kEdgeLipSlot };
+enum SlotKind { kNodeSlot, kEdgeSlot, kFaceSlot, kNodeLipSlot, kEdgeLipSlot, kSlotKinds };
 
 struct Candidate {
   ProximityContact contact;
   double distance = kInfinity;
   std::array<std::pair<int, int>, 2> slots;  // (kind, 2 * element + side)
+};
+
+// What a candidate competes with: its distance (infinity if not within the thickness) and its two slots.
+struct SlotClaim {
+  double distance = kInfinity;
+  std::array<std::pair<int, int>, 2> slots;
 };
 
 class ProximitySearch {
@@ -145,28 +150,39 @@ std::vector<ProximityContact> find_proximities(const ContactGeometry& g, BvhCach
   const std::vector<PrimitivePair> pairs = find_candidates(g, cache, options);
 
   const ProximitySearch search(g, params);
-  std::vector<Candidate> candidates(pairs.size());
+  // First each pair's distance and slots only (most pairs are beyond the thickness); the kept pairs' contacts
+  // are evaluated again afterwards, to the same values.
+  std::vector<SlotClaim> claims(pairs.size());
 #pragma omp parallel for schedule(dynamic, 64) if (pairs.size() > 2048)
-  for (int k = 0; k < static_cast<int>(pairs.size()); ++k) candidates[k] = search.evaluate(pairs[k]);
+  for (int k = 0; k < static_cast<int>(pairs.size()); ++k) {
+    const Candidate c = search.evaluate(pairs[k]);
+    claims[k] = {c.distance, c.slots};
+  }
 
-  // Nearest partner per slot; ties go to the earlier pair (deterministic).
-  std::map<std::pair<int, int>, int> best;
-  for (int k = 0; k < static_cast<int>(candidates.size()); ++k) {
-    if (candidates[k].distance == kInfinity) continue;
-    for (const auto& slot : candidates[k].slots) {
-      auto it = best.find(slot);
-      if (it == best.end())
-        best.emplace(slot, k);
-      else if (candidates[k].distance < candidates[it->second].distance)
-        it->second = k;
+  // Nearest partner per slot; ties go to the earlier pair (deterministic). A slot is (kind, 2 * element + side),
+  // its element a node, an edge or a face.
+  const int elements = std::max({g.node_count(), static_cast<int>(g.edges.size()), static_cast<int>(g.faces.size())});
+  std::vector<int> best(static_cast<size_t>(kSlotKinds) * 2 * elements, -1);
+  const auto slot_index = [&](const std::pair<int, int>& slot) {
+    return static_cast<size_t>(slot.first) * 2 * elements + slot.second;
+  };
+  for (int k = 0; k < static_cast<int>(claims.size()); ++k) {
+    if (claims[k].distance == kInfinity) continue;
+    for (const auto& slot : claims[k].slots) {
+      int& holder = best[slot_index(slot)];
+      if (holder < 0 || claims[k].distance < claims[holder].distance) holder = k;
     }
   }
-  std::vector<char> kept(candidates.size(), 0);
-  for (const auto& entry : best) kept[entry.second] = 1;
+  std::vector<char> kept(claims.size(), 0);
+  for (int k = 0; k < static_cast<int>(claims.size()); ++k) {
+    if (claims[k].distance == kInfinity) continue;
+    for (const auto& slot : claims[k].slots)
+      if (best[slot_index(slot)] == k) kept[k] = 1;
+  }
 
   std::vector<ProximityContact> contacts;
-  for (size_t k = 0; k < candidates.size(); ++k)
-    if (kept[k]) contacts.push_back(candidates[k].contact);
+  for (size_t k = 0; k < claims.size(); ++k)
+    if (kept[k]) contacts.push_back(search.evaluate(pairs[k]).contact);
 
   if (params.floor) {
     for (const auto& r : g.meshes) {
