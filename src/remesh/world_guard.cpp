@@ -207,19 +207,53 @@ bool WorldGuard::touches(std::int64_t entry, const int* nodes, int count) const 
   return false;
 }
 
-// Both queries gather the candidates of all their shapes at once (one grid walk and one sort), then test each
-// candidate against the shapes whose boxes it meets.
-double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced) const {
+namespace {
+
+// The boxes the queries test candidates against: each triangle's grown by the clearance, each sweep's own. Empty
+// if one is not finite (a query then answers as if blocked).
+std::vector<Eigen::AlignedBox3d> separation_boxes(const std::vector<GuardTriangle>& triangles, double clearance) {
   std::vector<Eigen::AlignedBox3d> boxes;
-  Eigen::AlignedBox3d all;
   for (const GuardTriangle& t : triangles) {
-    boxes.push_back(box_of(t.x, clearance_));
-    if (!boxes.back().min().allFinite() || !boxes.back().max().allFinite()) return 0;
-    all.extend(boxes.back());
+    boxes.push_back(box_of(t.x, clearance));
+    if (!boxes.back().min().allFinite() || !boxes.back().max().allFinite()) return {};
   }
+  return boxes;
+}
+
+std::vector<Eigen::AlignedBox3d> sweep_boxes(const std::vector<GuardSweep>& sweeps) {
+  std::vector<Eigen::AlignedBox3d> boxes;
+  for (const GuardSweep& s : sweeps) {
+    Eigen::AlignedBox3d b;
+    for (const Vec3& p : s.x) b.extend(p);
+    if (!b.min().allFinite() || !b.max().allFinite()) return {};
+    boxes.push_back(b);
+  }
+  return boxes;
+}
+
+Eigen::AlignedBox3d union_of(const std::vector<Eigen::AlignedBox3d>& boxes) {
+  Eigen::AlignedBox3d all;
+  for (const Eigen::AlignedBox3d& b : boxes) all.extend(b);
+  return all;
+}
+
+}  // namespace
+
+// Each query gathers the candidates of all its shapes at once (one grid walk and one sort), then tests each
+// candidate against the shapes whose boxes it meets; so any superset of the candidates gives the same answer,
+// and allows() walks the grid once for its three queries.
+double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced) const {
   if (triangles.empty()) return clearance_;
+  const std::vector<Eigen::AlignedBox3d> boxes = separation_boxes(triangles, clearance_);
+  if (boxes.empty()) return 0;
+  return separation_among(triangles, boxes, replaced, candidates(union_of(boxes)));
+}
+
+double WorldGuard::separation_among(const std::vector<GuardTriangle>& triangles,
+                                    const std::vector<Eigen::AlignedBox3d>& boxes, const std::vector<int>& replaced,
+                                    const std::vector<std::int64_t>& found) const {
   double nearest = clearance_;
-  for (const std::int64_t entry : candidates(all)) {
+  for (const std::int64_t entry : found) {
     if (!counts(entry, replaced)) continue;
     const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
     const Eigen::AlignedBox3d other_box = box_of(other.x, 0);
@@ -235,17 +269,16 @@ double WorldGuard::separation(const std::vector<GuardTriangle>& triangles, const
 }
 
 bool WorldGuard::sweep_is_clear(const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
-  std::vector<Eigen::AlignedBox3d> boxes;
-  Eigen::AlignedBox3d all;
-  for (const GuardSweep& s : sweeps) {
-    Eigen::AlignedBox3d b;
-    for (const Vec3& p : s.x) b.extend(p);
-    if (!b.min().allFinite() || !b.max().allFinite()) return false;
-    boxes.push_back(b);
-    all.extend(b);
-  }
   if (sweeps.empty()) return true;
-  for (const std::int64_t entry : candidates(all)) {
+  const std::vector<Eigen::AlignedBox3d> boxes = sweep_boxes(sweeps);
+  if (boxes.empty()) return false;
+  return sweep_is_clear_among(sweeps, boxes, replaced, candidates(union_of(boxes)));
+}
+
+bool WorldGuard::sweep_is_clear_among(const std::vector<GuardSweep>& sweeps,
+                                      const std::vector<Eigen::AlignedBox3d>& boxes, const std::vector<int>& replaced,
+                                      const std::vector<std::int64_t>& found) const {
+  for (const std::int64_t entry : found) {
     if (!counts(entry, replaced)) continue;
     const GuardTriangle other = triangle(static_cast<int>(entry >> 32), static_cast<int>(entry & 0xffffffff));
     const Eigen::AlignedBox3d other_box = box_of(other.x, 0);
@@ -319,10 +352,23 @@ bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vec
                         const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
   std::vector<int> sorted = replaced;
   std::sort(sorted.begin(), sorted.end());
-  if (!sweep_is_clear(sweeps, sorted)) return false;
-  const double gap_after = separation(after, sorted);
+  const std::vector<Eigen::AlignedBox3d> sweep_box = sweep_boxes(sweeps);
+  const std::vector<Eigen::AlignedBox3d> after_box = separation_boxes(after, clearance_);
+  const std::vector<Eigen::AlignedBox3d> before_box = separation_boxes(before, clearance_);
+  if (sweep_box.size() != sweeps.size() || after_box.size() != after.size() || before_box.size() != before.size()) {
+    // A shape that is not finite: the separate queries give their own answers.
+    if (!sweep_is_clear(sweeps, sorted)) return false;
+    const double gap_after = separation(after, sorted);
+    return gap_after >= clearance_ || gap_after >= separation(before, sorted);
+  }
+  Eigen::AlignedBox3d all = union_of(sweep_box);
+  all.extend(union_of(after_box));
+  all.extend(union_of(before_box));
+  const std::vector<std::int64_t> found = all.isEmpty() ? std::vector<std::int64_t>() : candidates(all);
+  if (!sweeps.empty() && !sweep_is_clear_among(sweeps, sweep_box, sorted, found)) return false;
+  const double gap_after = after.empty() ? clearance_ : separation_among(after, after_box, sorted, found);
   if (gap_after >= clearance_) return true;
-  return gap_after >= separation(before, sorted);
+  return gap_after >= (before.empty() ? clearance_ : separation_among(before, before_box, sorted, found));
 }
 
 }  // namespace arcsim

@@ -93,6 +93,12 @@ class WorldGuard {
   // Entries of the cells the box touches, plus the large faces, that meet the box where they are now (live
   // faces only); sorted, unique.
   std::vector<std::int64_t> candidates(const Eigen::AlignedBox3d& box) const;
+  // separation and sweep_is_clear, testing only the candidates `found` (any superset of those whose boxes meet
+  // the shapes' `boxes`, one per shape, finite).
+  double separation_among(const std::vector<GuardTriangle>& triangles, const std::vector<Eigen::AlignedBox3d>& boxes,
+                          const std::vector<int>& replaced, const std::vector<std::int64_t>& found) const;
+  bool sweep_is_clear_among(const std::vector<GuardSweep>& sweeps, const std::vector<Eigen::AlignedBox3d>& boxes,
+                            const std::vector<int>& replaced, const std::vector<std::int64_t>& found) const;
   // Whether the candidate face takes part: it is another mesh's, or a live face of the edited mesh that the
   // edit does not replace.
   bool counts(std::int64_t entry, const std::vector<int>& replaced) const;
