@@ -136,6 +136,42 @@ bool should_flip(const Mesh& m, int e, double threshold, double max_surface_chan
 
 namespace {
 
+// Counts the session's edits and stamps each node with the count at the last edit that touched its neighbourhood:
+// the nodes of every face an edit removed or added, and every node sharing a live face with one of them. An
+// answer that depends only on a node's faces and their nodes (their positions, rest positions, sizing and
+// plastic state, which only the nodes of an edit's faces see change) is still valid while the stamp is not newer
+// than the answer. Edits move only nodes of the faces they add (a split's new node, a collapse's kept node).
+class NeighbourhoodClock : public EditObserver {
+ public:
+  explicit NeighbourhoodClock(const Mesh& mesh) : m_(mesh) {}
+
+  void stage_done(EditKind, EditStage stage, const EditResult& result) override {
+    if (stage != EditStage::kDone || !result.ok) return;
+    ++edits_;
+    if (stamp_.size() < m_.nodes.size()) stamp_.resize(m_.nodes.size(), 0);
+    touched_.clear();
+    for (const std::vector<int>* faces : {&result.removed_faces, &result.added_faces})
+      for (int f : *faces)
+        for (int i = 0; i < 3; ++i) touched_.push_back(m_.face_node(f, i));
+    for (int n : touched_) {
+      stamp_[n] = edits_;
+      if (m_.nodes[n].dead) continue;
+      for (int f : m_.node_faces(n))
+        for (int i = 0; i < 3; ++i) stamp_[m_.face_node(f, i)] = edits_;
+    }
+  }
+
+  long edits() const { return edits_; }
+  // The count at the last edit around node n (0: none since the clock started).
+  long stamp(int n) const { return n < static_cast<int>(stamp_.size()) ? stamp_[n] : 0; }
+
+ private:
+  const Mesh& m_;
+  long edits_ = 0;
+  std::vector<long> stamp_;
+  std::vector<int> touched_;
+};
+
 // The remesher is a client of the edit session (edit/edit_session.hpp): it sizes the mesh and chooses which
 // edge to split, flip or collapse, and in which order; everything an edit needs beyond that (rest positions and
 // angles, plastic transfer, reprojection, the world guard, the subset's bookkeeping) is the session's.
@@ -144,8 +180,9 @@ class Remesher {
   Remesher(Mesh& mesh, const std::vector<Material>& materials, const RemeshOptions& options,
            const std::vector<int>* subset)
       : m_(mesh), materials_(materials), o_(options), subset_(subset),
-        session_(mesh, materials, edit_session_options(options), subset) {
+        clock_(mesh), session_(mesh, materials, edit_session_options(options), subset) {
     for (EditObserver* observer : o_.observers) session_.add_observer(observer);
+    session_.add_observer(&clock_);
     const RemeshingParams& r = o_.sizing.remeshing;
     aspect_min_ = positive_finite(r.aspect_min) ? std::min(r.aspect_min, 1.0) : kDefaultAspectMin;
     min_area_ = positive_finite(r.size_min) ? 0.1 * r.size_min * r.size_min : 0.0;
@@ -381,13 +418,24 @@ class Remesher {
   }
 
   bool collapse(int e) {
+    // can_collapse reads only the faces around the edge's two nodes: an edge it turned down on both sides stays
+    // turned down until an edit touches one of those neighbourhoods. (Most edges are shorter than 1 and asked
+    // again in every round, and a round after the first makes a few dozen edits among ~20 000 such edges.)
+    const Edge& edge = m_.edges[e];
+    if (o_.remember_refused_collapses && static_cast<size_t>(e) < refused_at_.size() && refused_at_[e] >= 0 &&
+        clock_.stamp(edge.n[0]) <= refused_at_[e] && clock_.stamp(edge.n[1]) <= refused_at_[e])
+      return false;
+    bool ruled_out = true;
     for (int side = 0; side < 2; ++side) {
       if (!can_collapse(e, side)) continue;
+      ruled_out = false;
       const int keep = m_.edges[e].n[1 - side];
       if (!session_.collapse_edge(e, side).ok) continue;
       flip_around(keep);
       return true;
     }
+    if (refused_at_.size() < m_.edges.size()) refused_at_.resize(m_.edges.size(), -1);
+    refused_at_[e] = ruled_out ? clock_.edits() : -1;
     return false;
   }
 
@@ -410,7 +458,10 @@ class Remesher {
   const std::vector<Material>& materials_;
   const RemeshOptions& o_;
   const std::vector<int>* subset_;
+  NeighbourhoodClock clock_;  // before the session, which holds a pointer to it
   EditSession session_;
+  // Per edge: the clock's count when can_collapse last turned down both of its sides (-1: not since).
+  std::vector<long> refused_at_;
   double aspect_min_ = 0, min_area_ = 0;
 };
 

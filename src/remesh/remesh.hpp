@@ -46,6 +46,9 @@ struct RemeshOptions {
   WorldGuard* shared_guard = nullptr;  // see EditSessionOptions::shared_guard
   std::vector<EditObserver*> observers;  // told about every edit of the pass (edit/edit_session.hpp)
   int max_rounds = 30;                 // split rounds and collapse rounds, each
+  // A collapse round asks again only the edges whose neighbourhood an edit touched since they were last turned
+  // down (the same answers as asking every edge: tests compare the two). false: every edge in every round.
+  bool remember_refused_collapses = true;
   size_t max_faces = 2000000;          // no split beyond this many live faces (a safety net, not a size control)
 };
 
