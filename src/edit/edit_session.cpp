@@ -523,9 +523,10 @@ bool EditSession::move_allowed(int node, const std::vector<int>& faces, const Ve
   }
   std::vector<int> exempt = options.exempt_faces;
   std::sort(exempt.begin(), exempt.end());
-  if (guard_->folds_through_neighbours(after, fan_and(exempt, m_.node_faces(node)))) return false;
-  if (!options.require_clearance) return guard_->sweep_is_clear(sweeps, exempt);
-  return guard_->allows(before, after, sweeps, exempt);
+  const std::vector<int> fold_replaced = fan_and(exempt, m_.node_faces(node));
+  if (!options.require_clearance)
+    return !guard_->folds_through_neighbours(after, fold_replaced) && guard_->sweep_is_clear(sweeps, exempt);
+  return guard_->allows_move(before, after, sweeps, &fold_replaced, exempt);
 }
 
 // The stress-free part of a node move: its elastic faces' rest shape moves with it (a cut, not a strain), and
@@ -564,13 +565,14 @@ bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, 
   auto allowed = [&] {
     // The fan is checked against itself and the faces it touches (the guard's other tests skip those).
     const std::vector<GuardTriangle> moved = guard_->fan(node);
-    if (guard_->folds_through_neighbours(moved, fan_and(options.exempt_faces, m_.node_faces(node)))) return false;
+    const std::vector<int> fold_replaced = fan_and(options.exempt_faces, m_.node_faces(node));
     if (!options.require_clearance) {
+      if (guard_->folds_through_neighbours(moved, fold_replaced)) return false;
       std::vector<int> sorted = options.exempt_faces;
       std::sort(sorted.begin(), sorted.end());
       return guard_->sweep_is_clear(guard_->fan_sweep(node, x), sorted);
     }
-    return guard_->allows(before, moved, guard_->fan_sweep(node, x), options.exempt_faces);
+    return guard_->allows_move(before, moved, guard_->fan_sweep(node, x), &fold_replaced, options.exempt_faces);
   };
   if (m_.nodes[node].x != x && !allowed()) {
     m_.nodes[node].x = x;

@@ -80,6 +80,7 @@ WorldGuard::WorldGuard(const Mesh& mesh, const std::vector<const Mesh*>& others,
     : mesh_(mesh), clearance_(clearance) {
   meshes_.push_back(&mesh);
   meshes_.insert(meshes_.end(), others.begin(), others.end());
+  seen_.resize(meshes_.size());
   build();
 }
 
@@ -171,11 +172,19 @@ std::vector<GuardSweep> WorldGuard::fan_sweep(int n, const Vec3& from) const {
 }
 
 std::vector<std::int64_t> WorldGuard::candidates(const Eigen::AlignedBox3d& box) const {
-  // Only faces whose box (where they are now) meets the query box: the callers skip the others anyway, and
-  // the grid holds stale and repeated entries of moved faces.
+  // Only faces whose box (where they are now) meets the query box: the callers skip the others anyway. The grid
+  // holds a face once per cell it covers, and again (stale) after it moved: each is looked at once per query.
+  if (++query_ == 0) {
+    for (auto& stamps : seen_) std::fill(stamps.begin(), stamps.end(), 0);
+    query_ = 1;
+  }
   std::vector<std::int64_t> found;
   auto add = [&](std::int64_t entry) {
     const int mesh = static_cast<int>(entry >> 32), face = static_cast<int>(entry & 0xffffffff);
+    std::vector<std::uint32_t>& stamps = seen_[mesh];
+    if (stamps.size() <= static_cast<size_t>(face)) stamps.resize(meshes_[mesh]->faces.size(), 0);
+    if (stamps[face] == query_) return;
+    stamps[face] = query_;
     if (mesh == 0 && mesh_.faces[face].dead) return;  // never counts
     const GuardTriangle t = triangle(mesh, face);
     if (box.intersects(box_of(t.x, 0))) found.push_back(entry);
@@ -190,7 +199,6 @@ std::vector<std::int64_t> WorldGuard::candidates(const Eigen::AlignedBox3d& box)
           for (const std::int64_t entry : it->second) add(entry);
       }
   std::sort(found.begin(), found.end());
-  found.erase(std::unique(found.begin(), found.end()), found.end());
   return found;
 }
 
@@ -308,18 +316,27 @@ std::array<int, 2> single_shared_corner(const std::array<int, 3>& a, const std::
 
 bool WorldGuard::folds_through_neighbours(const std::vector<GuardTriangle>& triangles,
                                           const std::vector<int>& replaced) const {
+  Eigen::AlignedBox3d all;
+  for (const GuardTriangle& t : triangles) all.extend(box_of(t.x, 0));
+  if (triangles.empty() || !all.min().allFinite() || !all.max().allFinite())
+    return folds_among(triangles, replaced, nullptr);
+  const std::vector<std::int64_t> found = candidates(all);
+  return folds_among(triangles, replaced, &found);
+}
+
+bool WorldGuard::folds_among(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced,
+                             const std::vector<std::int64_t>* found) const {
   auto folds = [](const GuardTriangle& a, const GuardTriangle& b) {
     const std::array<int, 2> c = single_shared_corner(a.nodes, b.nodes);
     return c[0] >= 0 && triangles_meet_beyond_corner(a.x, c[0], b.x, c[1]);
   };
-  Eigen::AlignedBox3d all;
-  for (size_t i = 0; i < triangles.size(); ++i) {
-    all.extend(box_of(triangles[i].x, 0));
+  for (size_t i = 0; i < triangles.size(); ++i)
     for (size_t k = i + 1; k < triangles.size(); ++k)
       if (folds(triangles[i], triangles[k])) return true;
-  }
-  if (triangles.empty() || !all.min().allFinite() || !all.max().allFinite()) return false;
-  for (const std::int64_t entry : candidates(all)) {
+  if (found == nullptr) return false;
+  // A face that folds through a triangle shares a node with it and meets it elsewhere, so its box meets the
+  // triangle's: every candidate list that holds the faces meeting the triangles' boxes gives the same answer.
+  for (const std::int64_t entry : *found) {
     if (entry >> 32 != 0 || !counts(entry, replaced)) continue;
     const GuardTriangle other = triangle(0, static_cast<int>(entry & 0xffffffff));
     for (const GuardTriangle& t : triangles)
@@ -350,6 +367,12 @@ bool edit_makes_crossing(const std::vector<GuardTriangle>& before, const std::ve
 
 bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
                         const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const {
+  return allows_move(before, after, sweeps, nullptr, replaced);
+}
+
+bool WorldGuard::allows_move(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
+                             const std::vector<GuardSweep>& sweeps, const std::vector<int>* fold_replaced,
+                             const std::vector<int>& replaced) const {
   std::vector<int> sorted = replaced;
   std::sort(sorted.begin(), sorted.end());
   const std::vector<Eigen::AlignedBox3d> sweep_box = sweep_boxes(sweeps);
@@ -357,14 +380,18 @@ bool WorldGuard::allows(const std::vector<GuardTriangle>& before, const std::vec
   const std::vector<Eigen::AlignedBox3d> before_box = separation_boxes(before, clearance_);
   if (sweep_box.size() != sweeps.size() || after_box.size() != after.size() || before_box.size() != before.size()) {
     // A shape that is not finite: the separate queries give their own answers.
+    if (fold_replaced != nullptr && folds_through_neighbours(after, *fold_replaced)) return false;
     if (!sweep_is_clear(sweeps, sorted)) return false;
     const double gap_after = separation(after, sorted);
     return gap_after >= clearance_ || gap_after >= separation(before, sorted);
   }
+  // One walk of the grid for every query: each filters the candidates by its own shapes' boxes (the after
+  // triangles' own boxes, which the fold test needs, lie inside their boxes grown by the clearance).
   Eigen::AlignedBox3d all = union_of(sweep_box);
   all.extend(union_of(after_box));
   all.extend(union_of(before_box));
   const std::vector<std::int64_t> found = all.isEmpty() ? std::vector<std::int64_t>() : candidates(all);
+  if (fold_replaced != nullptr && folds_among(after, *fold_replaced, after.empty() ? nullptr : &found)) return false;
   if (!sweeps.empty() && !sweep_is_clear_among(sweeps, sweep_box, sorted, found)) return false;
   const double gap_after = after.empty() ? clearance_ : separation_among(after, after_box, sorted, found);
   if (gap_after >= clearance_) return true;

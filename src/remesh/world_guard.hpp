@@ -75,6 +75,12 @@ class WorldGuard {
   bool allows(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
               const std::vector<GuardSweep>& sweeps, const std::vector<int>& replaced) const;
 
+  // A node's move: false if `after` folds through a neighbour (folds_through_neighbours with `fold_replaced`,
+  // unless nullptr), else allows(before, after, sweeps, replaced); the same answers from one walk of the grid.
+  bool allows_move(const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
+                   const std::vector<GuardSweep>& sweeps, const std::vector<int>* fold_replaced,
+                   const std::vector<int>& replaced) const;
+
   // The world triangles of the live faces around node n of the edited mesh, where they are now.
   std::vector<GuardTriangle> fan(int n) const;
   // The tetrahedra the faces around node n swept when n moved from `from` to where it is now.
@@ -97,6 +103,9 @@ class WorldGuard {
   // the shapes' `boxes`, one per shape, finite).
   double separation_among(const std::vector<GuardTriangle>& triangles, const std::vector<Eigen::AlignedBox3d>& boxes,
                           const std::vector<int>& replaced, const std::vector<std::int64_t>& found) const;
+  // folds_through_neighbours against the candidates `found` (nullptr: the triangles against each other only).
+  bool folds_among(const std::vector<GuardTriangle>& triangles, const std::vector<int>& replaced,
+                   const std::vector<std::int64_t>* found) const;
   bool sweep_is_clear_among(const std::vector<GuardSweep>& sweeps, const std::vector<Eigen::AlignedBox3d>& boxes,
                             const std::vector<int>& replaced, const std::vector<std::int64_t>& found) const;
   // Whether the candidate face takes part: it is another mesh's, or a live face of the edited mesh that the
@@ -117,6 +126,9 @@ class WorldGuard {
   // guard was built on, and a remesh that refines 2 faces to 1000 (ARCSim's square.json, first frame) left every
   // face in one cell, and every query sorted thousands of entries.
   long built_faces_ = 0, added_faces_ = 0;
+  // Per mesh and face: the last query (candidates) that looked at it. Queries are therefore not thread-safe.
+  mutable std::vector<std::vector<std::uint32_t>> seen_;
+  mutable std::uint32_t query_ = 0;
 };
 
 }  // namespace arcsim

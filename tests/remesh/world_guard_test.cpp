@@ -5,6 +5,8 @@
 // without it the same pass crosses it or leaves it outside (so the test can tell).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
 #include <stdexcept>
 
 #include "collision/triangle_intersection.hpp"
@@ -125,6 +127,47 @@ TEST(WorldGuard, AllowsEditsThatComeNoCloserThanBefore) {
   GuardSweep sweep{{low.x[0], through.x[0], low.x[1], low.x[2]}, {}};
   EXPECT_FALSE(guard.allows({low}, {through}, {sweep}, {}));
   EXPECT_TRUE(guard.allows({low}, {high}, {GuardSweep{{low.x[0], high.x[0], low.x[1], low.x[2]}, {}}}, {}));
+}
+
+// allows_move answers from one walk of the grid what its queries answer each from their own: random moves of
+// nodes of a bumpy sheet over a second bumpy sheet (an obstacle), some through it, some folding a fan.
+TEST(WorldGuard, AllowsMoveAnswersAsItsSeparateQueries) {
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> sym(-1, 1);
+  Mesh sheet = testing::make_grid(10, 10, 1.0, 1.0, testing::Diagonal::kAlternating);
+  Mesh obstacle = testing::make_grid(6, 6, 1.2, 1.2, testing::Diagonal::kForward, -0.1, -0.1);
+  for (Node& n : sheet.nodes) n.x.z() = n.x0.z() = 0.03 * std::sin(11 * n.x.x()) * std::cos(9 * n.x.y());
+  for (Node& n : obstacle.nodes) n.x.z() = n.x0.z() = -0.04 + 0.02 * sym(rng);
+  const WorldGuard guard(sheet, {&obstacle}, 0.01);
+  int kept = 0, refused = 0, folded = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    const int node = static_cast<int>(rng() % sheet.nodes.size());
+    const Vec3 from = sheet.nodes[node].x;
+    const double reach = trial % 3 == 0 ? 0.25 : 0.03;
+    const std::vector<GuardTriangle> before = guard.fan(node);
+    sheet.nodes[node].x += reach * Vec3(sym(rng), sym(rng), sym(rng));
+    const std::vector<GuardTriangle> after = guard.fan(node);
+    const std::vector<GuardSweep> sweeps = guard.fan_sweep(node, from);
+    const std::vector<int> fan_faces = sheet.node_faces(node);  // ascending
+    std::vector<int> replaced;
+    if (trial % 2 == 1) replaced.push_back(fan_faces[rng() % fan_faces.size()]);
+    std::vector<int> sorted = replaced;
+    std::sort(sorted.begin(), sorted.end());
+    const bool folds = guard.folds_through_neighbours(after, fan_faces);
+    const double gap_after = guard.separation(after, sorted);
+    const bool separately = !folds && guard.sweep_is_clear(sweeps, sorted) &&
+                            (gap_after >= guard.clearance() || gap_after >= guard.separation(before, sorted));
+    ASSERT_EQ(guard.allows_move(before, after, sweeps, &fan_faces, replaced), separately) << "trial " << trial;
+    ASSERT_EQ(guard.allows_move(before, after, sweeps, nullptr, replaced), guard.allows(before, after, sweeps, replaced))
+        << "trial " << trial;
+    (separately ? kept : refused) += 1;
+    folded += folds;
+    sheet.nodes[node].x = from;
+  }
+  // Both answers, and refusals by the fold test, occurred.
+  EXPECT_GT(kept, 50);
+  EXPECT_GT(refused, 50);
+  EXPECT_GT(folded, 5);
 }
 
 // An edit that splits a node (a crack opening) may not leave two of its own faces crossing: faces that shared
