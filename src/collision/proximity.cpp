@@ -174,11 +174,8 @@ std::vector<ProximityContact> find_proximities(const ContactGeometry& g, BvhCach
     }
   }
   std::vector<char> kept(claims.size(), 0);
-  for (int k = 0; k < static_cast<int>(claims.size()); ++k) {
-    if (claims[k].distance == kInfinity) continue;
-    for (const auto& slot : claims[k].slots)
-      if (best[slot_index(slot)] == k) kept[k] = 1;
-  }
+  for (const int holder : best)
+    if (holder >= 0) kept[holder] = 1;
 
   std::vector<ProximityContact> contacts;
   for (size_t k = 0; k < claims.size(); ++k)

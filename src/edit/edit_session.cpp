@@ -521,6 +521,13 @@ bool EditSession::move_allowed(int node, const std::vector<int>& faces, const Ve
     after.push_back({{to, x0, x1}, {node, b0, b1}});
     sweeps.push_back({{from, to, x0, x1}, {node, node, b0, b1}});
   }
+  return guard_allows_move(node, before, after, sweeps, options);
+}
+
+bool EditSession::guard_allows_move(int node, const std::vector<GuardTriangle>& before,
+                                    const std::vector<GuardTriangle>& after, const std::vector<GuardSweep>& sweeps,
+                                    const NodeMoveOptions& options) const {
+  // The moved fan is checked against itself and the faces it touches (the guard's other tests skip those).
   std::vector<int> exempt = options.exempt_faces;
   std::sort(exempt.begin(), exempt.end());
   const std::vector<int> fold_replaced = fan_and(exempt, m_.node_faces(node));
@@ -562,19 +569,8 @@ bool EditSession::reproject_unchecked(int node) {
 bool EditSession::keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
                             const NodeMoveOptions& options) {
   if (!guard_) return true;
-  auto allowed = [&] {
-    // The fan is checked against itself and the faces it touches (the guard's other tests skip those).
-    const std::vector<GuardTriangle> moved = guard_->fan(node);
-    const std::vector<int> fold_replaced = fan_and(options.exempt_faces, m_.node_faces(node));
-    if (!options.require_clearance) {
-      if (guard_->folds_through_neighbours(moved, fold_replaced)) return false;
-      std::vector<int> sorted = options.exempt_faces;
-      std::sort(sorted.begin(), sorted.end());
-      return guard_->sweep_is_clear(guard_->fan_sweep(node, x), sorted);
-    }
-    return guard_->allows_move(before, moved, guard_->fan_sweep(node, x), &fold_replaced, options.exempt_faces);
-  };
-  if (m_.nodes[node].x != x && !allowed()) {
+  if (m_.nodes[node].x != x &&
+      !guard_allows_move(node, before, guard_->fan(node), guard_->fan_sweep(node, x), options)) {
     m_.nodes[node].x = x;
     m_.nodes[node].x0 = x0;
     ++counts_.guarded;

@@ -194,6 +194,10 @@ class EditSession {
   // kReprojection: `node` even if preserved (split_node marks every node it splits preserved).
   bool reproject_unchecked(int node);
   // kGuardMoves
+  // Whether the guard keeps node's move from the triangles `before` to `after` through `sweeps` (its fan's
+  // faces, as move_node and move_allowed check them).
+  bool guard_allows_move(int node, const std::vector<GuardTriangle>& before, const std::vector<GuardTriangle>& after,
+                         const std::vector<GuardSweep>& sweeps, const NodeMoveOptions& options) const;
   bool keep_move(int node, const std::vector<GuardTriangle>& before, const Vec3& x, const Vec3& x0,
                  const NodeMoveOptions& options = {});
   GuardTriangle world_triangle(std::array<int, 3> nodes) const;

@@ -1,8 +1,8 @@
 #include "remesh/remesh.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <unordered_set>
 #include <utility>
 
