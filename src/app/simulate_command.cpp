@@ -186,6 +186,7 @@ void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& optio
   Progress progress(style, console, sim.total_frames());
   const int save_every = std::max(1, sim.scene().save_every);
   int last_saved = sim.frame();
+  ThreadGovernor threads(options.threads);
   try {
     while (!sim.finished()) {
       sim.times.clear();
@@ -207,6 +208,7 @@ void run_frames(Simulation& sim, OutputFolder* out, const SimulateOptions& optio
       if (out) out->log(frame_log_line(report));
       if (!options.quiet) print_collision_warnings(report.impact_zones, progress, console);
       progress.frame_done(report);
+      threads.frame_done();
     }
   } catch (const NumericalError& e) {
     progress.end_line();

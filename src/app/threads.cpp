@@ -1,6 +1,13 @@
 #include "app/threads.hpp"
 
 #include <omp.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <string>
 
 namespace arcsim {
 
@@ -11,6 +18,64 @@ void configure_threads(int threads) {
   } else {
     omp_set_dynamic(1);
   }
+}
+
+namespace {
+
+double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
+
+}  // namespace
+
+CpuSample sample_cpu() {
+  CpuSample s;
+  s.wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) == 0) s.own = seconds(usage.ru_utime) + seconds(usage.ru_stime);
+  std::ifstream stat("/proc/stat");
+  std::string label;
+  // cpu  user nice system idle iowait irq softirq steal ...  (in clock ticks)
+  double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
+  if (stat >> label >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal && label == "cpu") {
+    const long ticks = sysconf(_SC_CLK_TCK);
+    if (ticks > 0) {
+      s.machine_busy = (user + nice + system + irq + softirq + steal) / static_cast<double>(ticks);
+      s.valid = true;
+    }
+  }
+  return s;
+}
+
+int cores_left_free(const CpuSample& before, const CpuSample& after, int cores) {
+  const double wall = after.wall - before.wall;
+  if (!before.valid || !after.valid || !(wall > 0)) return std::max(1, cores);
+  const double others = std::max(0.0, (after.machine_busy - before.machine_busy) - (after.own - before.own)) / wall;
+  const double free = static_cast<double>(cores) - others;
+  return std::clamp(static_cast<int>(std::lround(free)), 1, std::max(1, cores));
+}
+
+ThreadGovernor::ThreadGovernor(int threads) {
+  if (threads > 0) {
+    team_ = threads;
+    return;
+  }
+  last_ = sample_cpu();
+  if (!last_.valid) return;  // no /proc/stat: OpenMP's dynamic teams stay in charge
+  active_ = true;
+  cores_ = std::max(1, omp_get_num_procs());
+  team_ = cores_;
+  omp_set_dynamic(0);
+  omp_set_num_threads(team_);
+}
+
+void ThreadGovernor::frame_done() {
+  if (!active_) return;
+  const CpuSample now = sample_cpu();
+  if (now.wall - last_.wall < kMinInterval) return;
+  const int team = cores_left_free(last_, now, cores_);
+  last_ = now;
+  if (team == team_) return;
+  team_ = team;
+  omp_set_num_threads(team_);
 }
 
 }  // namespace arcsim
