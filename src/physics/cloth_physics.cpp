@@ -32,14 +32,29 @@ std::vector<std::pair<int, int>> sorted_node_pairs(std::vector<std::pair<int, in
   return pairs;
 }
 
+// Looks up every element's block ids in the pattern. Each element writes only its own ids, so threads change
+// nothing but the time (the lookups were 2% of flag.json's wall, all on one core).
+void refresh_block_ids(ElementCache& cache) {
+  const int faces = static_cast<int>(cache.faces.size());
+  const int count = faces + static_cast<int>(cache.bending.size());
+#pragma omp parallel for schedule(static) if (count > 4096)
+  for (int k = 0; k < count; ++k) {
+    if (k < faces) {
+      cache.faces[k].blocks = element_block_ids<3>(cache.pattern, cache.faces[k].dofs);
+    } else {
+      BendingElement& b = cache.bending[k - faces];
+      b.blocks = element_block_ids<6>(cache.pattern, b.dofs);
+    }
+  }
+}
+
 // Builds the block pattern from the element and contact pairs and refreshes the elements' block ids.
 void rebuild_pattern(ElementCache& cache) {
   cache.pattern_stale = false;
   std::vector<std::pair<int, int>> pairs = cache.element_pairs;
   pairs.insert(pairs.end(), cache.contact_pairs.begin(), cache.contact_pairs.end());
   cache.pattern.build(static_cast<int>(cache.node_mass.size()), std::move(pairs));
-  for (auto& f : cache.faces) f.blocks = element_block_ids<3>(cache.pattern, f.dofs);
-  for (auto& b : cache.bending) b.blocks = element_block_ids<6>(cache.pattern, b.dofs);
+  refresh_block_ids(cache);
 }
 
 }  // namespace
@@ -116,8 +131,7 @@ void build_element_cache(const Mesh& mesh, const std::vector<Material>& material
   // pairs, so CHOLMOD's symbolic analysis is reused (plastic flow changes faces every step while it lasts).
   if (!cache.pattern_stale && element_pairs == cache.element_pairs &&
       cache.pattern.node_count() == static_cast<int>(mesh.nodes.size()) && cache.pattern.block_count() > 0) {
-    for (auto& f : cache.faces) f.blocks = element_block_ids<3>(cache.pattern, f.dofs);
-    for (auto& b : cache.bending) b.blocks = element_block_ids<6>(cache.pattern, b.dofs);
+    refresh_block_ids(cache);
     return;
   }
   cache.element_pairs = std::move(element_pairs);
