@@ -1,12 +1,14 @@
 #include "app/threads.hpp"
 
 #include <omp.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 namespace arcsim {
@@ -31,16 +33,30 @@ CpuSample sample_cpu() {
   s.wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) s.own = seconds(usage.ru_utime) + seconds(usage.ru_stime);
+  // Only the CPUs this process may run on (in a container or under taskset the others are someone else's).
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  const bool masked = sched_getaffinity(0, sizeof(allowed), &allowed) == 0;
+  const long ticks = sysconf(_SC_CLK_TCK);
   std::ifstream stat("/proc/stat");
-  std::string label;
-  // cpu  user nice system idle iowait irq softirq steal ...  (in clock ticks)
-  double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
-  if (stat >> label >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal && label == "cpu") {
-    const long ticks = sysconf(_SC_CLK_TCK);
-    if (ticks > 0) {
-      s.machine_busy = (user + nice + system + irq + softirq + steal) / static_cast<double>(ticks);
-      s.valid = true;
-    }
+  std::string line;
+  double busy = 0;
+  int cpus = 0;
+  while (ticks > 0 && std::getline(stat, line)) {
+    // cpuN user nice system idle iowait irq softirq steal ...  (clock ticks)
+    if (line.compare(0, 3, "cpu") != 0) break;  // the cpu lines come first
+    if (line.size() < 4 || line[3] < '0' || line[3] > '9') continue;  // the machine's total line
+    std::istringstream fields(line.substr(3));
+    int cpu = -1;
+    double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
+    if (!(fields >> cpu >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal)) continue;
+    if (masked && (cpu < 0 || cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &allowed))) continue;
+    busy += user + nice + system + irq + softirq + steal;
+    ++cpus;
+  }
+  if (cpus > 0) {
+    s.machine_busy = busy / static_cast<double>(ticks);
+    s.valid = true;
   }
   return s;
 }
@@ -61,7 +77,8 @@ ThreadGovernor::ThreadGovernor(int threads) {
   last_ = sample_cpu();
   if (!last_.valid) return;  // no /proc/stat: OpenMP's dynamic teams stay in charge
   active_ = true;
-  cores_ = std::max(1, omp_get_num_procs());
+  // Never more than OMP_NUM_THREADS, when the user set it (the maximum team OpenMP would have used).
+  cores_ = std::max(1, std::min(omp_get_num_procs(), omp_get_max_threads()));
   team_ = cores_;
   omp_set_dynamic(0);
   omp_set_num_threads(team_);

@@ -13,8 +13,9 @@ namespace arcsim {
 // changes speed.
 void configure_threads(int threads);
 
-// CPU time counters at one instant: every CPU's busy time (/proc/stat: user, nice, system, irq, softirq and a
-// hypervisor's steal), this process's own CPU time (user + system) and a monotonic wall clock, all in seconds.
+// CPU time counters at one instant: the busy time of the CPUs this process may run on (/proc/stat's per-CPU
+// lines, for the CPUs of its affinity mask: user, nice, system, irq, softirq and a hypervisor's steal), this
+// process's own CPU time (user + system) and a monotonic wall clock, all in seconds.
 struct CpuSample {
   bool valid = false;  // /proc/stat could be read
   double machine_busy = 0, own = 0, wall = 0;
