@@ -1,11 +1,13 @@
 #include "physics/block_cholesky.hpp"
 
+#include <amd.h>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #endif
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "physics/block_system.hpp"
 
@@ -131,7 +133,15 @@ void BlockCholesky::analyse(const BlockPattern& pattern) {
   node_count_ = n;
   failed_row_ = -1;
 
-  order_ = pattern.fill_reducing_order();
+  // The node graph as compressed columns (the pattern's own storage: column c's blocks are consecutive, rows >= c
+  // ascending, the diagonal first), for AMD, which orders A + A' and ignores the diagonal.
+  std::vector<int> graph_start(n + 1), graph_row(blocks);
+  for (int c = 0; c < n; ++c) graph_start[c] = pattern.diagonal_block(c);
+  graph_start[n] = blocks;
+  for (int k = 0; k < blocks; ++k) graph_row[k] = pattern.block_row(k);
+  order_.resize(n);
+  if (n > 0 && amd_order(n, graph_start.data(), graph_row.data(), order_.data(), nullptr, nullptr) < 0)
+    throw std::runtime_error("AMD could not order the node graph of the implicit system");
   std::vector<int> position(n);
   for (int k = 0; k < n; ++k) position[order_[k]] = k;
 

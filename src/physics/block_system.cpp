@@ -1,12 +1,10 @@
 #include "physics/block_system.hpp"
 
-#include <amd.h>
 #include <omp.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <stdexcept>
 
 #include "math/counting_sort.hpp"
 
@@ -99,16 +97,6 @@ void BlockPattern::prepare_layout() const {
   layout_ready_ = true;
 }
 
-std::vector<int> BlockPattern::fill_reducing_order() const {
-  // The pattern's own storage is the node graph in compressed columns (column c's blocks consecutive, rows >= c
-  // ascending, the diagonal first); AMD orders A + A' and ignores the diagonal.
-  const int n = node_count_;
-  std::vector<int> order(n);
-  if (n > 0 && amd_order(n, col_start_.data(), block_row_.data(), order.data(), nullptr, nullptr) < 0)
-    throw std::runtime_error("AMD could not order the node graph of the implicit system");
-  return order;
-}
-
 int BlockPattern::block_index(int i, int j) const {
   if (i < j) std::swap(i, j);
   const auto begin = block_row_.begin() + col_start_[j], end = block_row_.begin() + col_start_[j + 1];
@@ -171,21 +159,6 @@ void SupernodalLLT::factorize_permuted_lower(cholmod_sparse& lower) {
   m_factorizationIsOk = true;
 }
 
-void SupernodalLLT::analyze_in_order(const Eigen::SparseMatrix<double>& upper, std::vector<int>& order) {
-  // As Eigen's analyzePattern does, with the order given.
-  cholmod_common& common = cholmod();
-  if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &common);
-  cholmod_sparse A = Eigen::viewAsCholmod(upper.selfadjointView<Eigen::Upper>());
-  common.nmethods = 1;
-  common.method[0].ordering = CHOLMOD_GIVEN;
-  m_cholmodFactor = cholmod_analyze_p(&A, order.data(), nullptr, 0, &common);
-  if (!m_cholmodFactor) throw std::runtime_error("CHOLMOD's symbolic analysis of the implicit system failed");
-  m_isInitialized = true;
-  m_info = Eigen::Success;
-  m_analysisIsOk = true;
-  m_factorizationIsOk = false;
-}
-
 int SupernodalLLT::failed_row() const {
   const cholmod_factor* L = m_cholmodFactor;
   if (!L || L->minor >= L->n) return -1;
@@ -237,18 +210,14 @@ bool CholeskySolver::factorize(const BlockSystem& system) {
     matrix_ = system.pattern->csc_structure();
     system.to_csc(matrix_);
     llt_ = std::make_unique<SupernodalLLT>();
-    // AMD on the node graph, each node's three rows kept together. CHOLMOD's own AMD on the scalar matrix finds
-    // the same 3x3 structure from a graph nine times larger: it was 45% of the analysis, and the analysis in
-    // flag.json's first second cost half as much as its factorisations (77 analyses, one per remesh or new
-    // contact pair, against 200 factorisations). The factors are as small (4.63e6 entries against 4.77e6 at
-    // the end of that second). AMD only: CHOLMOD's default also tries METIS when AMD's fill is high (from ~20k
-    // faces on) and keeps the smaller factor, but on our sheets METIS's was never smaller (64k faces: 3.15e7
-    // against AMD's 3.10e7 entries, the same flops) and trying it took 60% of the analysis.
-    const std::vector<int> node_order = system.pattern->fill_reducing_order();
-    std::vector<int> order(3 * node_order.size());
-    for (size_t k = 0; k < node_order.size(); ++k)
-      for (int c = 0; c < 3; ++c) order[3 * k + c] = 3 * node_order[k] + c;
-    llt_->analyze_in_order(matrix_, order);
+    // AMD only. CHOLMOD's default also tries METIS when AMD's fill is high (from ~20k faces on), and keeps the
+    // ordering with the smaller factor: on our sheets METIS's was never smaller (64k faces: 3.15e7 against
+    // AMD's 3.10e7 entries, the same flops), but trying it took 60% of the analysis (1.3 s against 0.54 s),
+    // paid again at every remesh. Below that size CHOLMOD tries AMD alone anyway: the same factor as before.
+    cholmod_common& common = llt_->cholmod();
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_AMD;
+    llt_->analyzePattern(matrix_);
     analysed_pattern_ = id;
     ++analyses_;
     prepare_permuted_layout();

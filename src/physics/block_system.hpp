@@ -42,9 +42,6 @@ class BlockPattern {
   uint64_t id() const { return id_; }
 
   int block_row(int k) const { return block_row_[k]; }
-
-  // A fill-reducing order of the nodes: AMD on the node graph. Node order[k] is the k-th eliminated.
-  std::vector<int> fill_reducing_order() const;
   int block_col(int k) const { return block_col_[k]; }
 
   // The layout of the factorised matrix, built on first use after each change of structure: only patterns that
@@ -130,9 +127,6 @@ class SupernodalLLT : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // Numeric factorisation from tril(P A P') (P the analysis's permutation), sorted compressed columns: what
   // factorize(A) hands CHOLMOD's supernodal phase after transposing A into that form, so the factor is the same.
   void factorize_permuted_lower(cholmod_sparse& lower);
-  // Symbolic analysis of the matrix whose upper triangle is `upper`, in the fill-reducing order `order` (row k of
-  // the permuted matrix is row order[k]), which CHOLMOD then postorders as it does its own orderings.
-  void analyze_in_order(const Eigen::SparseMatrix<double>& upper, std::vector<int>& order);
 };
 
 // What one solve_system did.

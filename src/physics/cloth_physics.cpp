@@ -146,75 +146,24 @@ void ensure_pattern(ElementCache& cache) {
   if (cache.pattern_stale) rebuild_pattern(cache);
 }
 
-namespace {
-
-// The pairs (a', b') with a' = a or a node sharing a face with a, and b' = b or one sharing a face with b, for
-// each (a, b) of `pairs`, as sorted_node_pairs gives them.
-std::vector<std::pair<int, int>> with_face_neighbours(const std::vector<FaceElement>& faces, int node_count,
-                                                      const std::vector<std::pair<int, int>>& pairs) {
-  // Face neighbours per node (repeats are harmless: the result is made unique).
-  std::vector<int> start(node_count + 2, 0);
-  for (const FaceElement& f : faces)
-    for (int n : f.nodes) start[n + 2] += 2;
-  for (int n = 0; n < node_count; ++n) start[n + 2] += start[n + 1];
-  std::vector<int> neighbours(start[node_count + 1]);
-  for (const FaceElement& f : faces)
-    for (int i = 0; i < 3; ++i) {
-      neighbours[start[f.nodes[i] + 1]++] = f.nodes[(i + 1) % 3];
-      neighbours[start[f.nodes[i] + 1]++] = f.nodes[(i + 2) % 3];
-    }
-  std::vector<std::pair<int, int>> grown;
-  for (const auto& [a, b] : pairs) {
-    grown.emplace_back(a, b);
-    for (int p = start[a]; p < start[a + 1]; ++p) {
-      grown.emplace_back(neighbours[p], b);
-      for (int q = start[b]; q < start[b + 1]; ++q) grown.emplace_back(neighbours[p], neighbours[q]);
-    }
-    for (int q = start[b]; q < start[b + 1]; ++q) grown.emplace_back(a, neighbours[q]);
-  }
-  return sorted_node_pairs(std::move(grown), node_count);
-}
-
-}  // namespace
-
-bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts, ContactReach reach) {
-  const int node_count = static_cast<int>(cache.node_mass.size());
+bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts) {
   std::vector<std::pair<int, int>> needed;
   for (const ContactTerm& c : contacts)
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < a; ++b)
         if (c.nodes[a] != kNone && c.nodes[b] != kNone && c.nodes[a] != c.nodes[b])
           needed.emplace_back(c.nodes[a], c.nodes[b]);
-  needed = sorted_node_pairs(std::move(needed), node_count);
+  needed = sorted_node_pairs(std::move(needed), static_cast<int>(cache.node_mass.size()));
   std::vector<std::pair<int, int>> extra;
   std::set_difference(needed.begin(), needed.end(), cache.element_pairs.begin(), cache.element_pairs.end(),
                       std::back_inserter(extra));
   const bool missing = !std::includes(cache.contact_pairs.begin(), cache.contact_pairs.end(), extra.begin(),
                                       extra.end());
   // Keeping stale pairs costs little (zero blocks) and avoids re-analysing the matrix every time a contact
-  // ends; shrink once they clearly dominate (the bound allows for the neighbourhoods taken below).
-  const bool bloated = cache.contact_pairs.size() > 64 * extra.size() + 4096;
+  // ends; shrink once they clearly dominate.
+  const bool bloated = cache.contact_pairs.size() > 2 * extra.size() + 256;
   if (!missing && !bloated && !cache.pattern_stale) return false;
-  // Contacts slide: a step's new contact pairs are mostly next to the last step's. A pair missing from the
-  // pattern costs a symbolic analysis (in flag.json's first second, 52 of 77 analyses came from contacts alone),
-  // so with kNeighbourhoods the pattern takes each contact pair's face neighbourhoods on both sides as well, and
-  // keeps the pairs it had: 54 analyses (docs/benchmarks.md). Eliminating a or b fills many of those pairs in
-  // anyway.
-  std::vector<std::pair<int, int>> pairs;
-  if (reach == ContactReach::kNeighbourhoods) {
-    const std::vector<std::pair<int, int>> grown = with_face_neighbours(cache.faces, node_count, extra);
-    std::set_difference(grown.begin(), grown.end(), cache.element_pairs.begin(), cache.element_pairs.end(),
-                        std::back_inserter(pairs));
-  } else {
-    pairs = std::move(extra);
-  }
-  if (!bloated && !cache.pattern_stale) {
-    std::vector<std::pair<int, int>> kept;
-    std::set_union(pairs.begin(), pairs.end(), cache.contact_pairs.begin(), cache.contact_pairs.end(),
-                   std::back_inserter(kept));
-    pairs.swap(kept);
-  }
-  cache.contact_pairs = std::move(pairs);
+  cache.contact_pairs = std::move(extra);
   rebuild_pattern(cache);
   return true;
 }

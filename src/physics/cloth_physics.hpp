@@ -87,17 +87,10 @@ void build_element_cache(const Mesh& mesh, const std::vector<Material>& material
 // Builds the block pattern if build_element_cache deferred it.
 void ensure_pattern(ElementCache& cache);
 
-// Which pairs a rebuilt pattern takes for a contact between nodes a and b: (a, b) alone, or also every pair of
-// a node of a's face neighbourhood with one of b's, so that the contact can slide without a new pattern (each
-// new pattern is a new symbolic analysis: worth it where CHOLMOD factorises, not for BlockCholesky's small
-// systems, whose analysis is cheap and whose factor grows with every pair).
-enum class ContactReach { kPairs, kNeighbourhoods };
-
 // Makes the pattern contain every node pair coupled by `contacts`. The pattern (and with it the CHOLMOD
 // symbolic analysis) is rebuilt only when a needed pair is missing, when far more contact pairs are kept
-// than needed, or when it was deferred; it keeps the contact pairs it had, unless rebuilt for those reasons
-// alone. Returns true if it was rebuilt.
-bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts, ContactReach reach);
+// than needed, or when it was deferred. Returns true if it was rebuilt.
+bool update_contact_pattern(ElementCache& cache, const std::vector<ContactTerm>& contacts);
 
 // Total elastic energy (J) of the cloth at its current world positions.
 double internal_energy(const Mesh& mesh, const ElementCache& cache);

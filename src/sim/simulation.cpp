@@ -226,9 +226,7 @@ void Simulation::physics_step(double dt) {
     Cloth& cloth = cloths[c];
     ExternalLoads loads = loads_for(static_cast<int>(c), time_);
     if (c < step_contacts_.size()) loads.contacts = step_contacts_[c];
-    const bool cholmod_sized = cloth.elements.node_mass.size() > static_cast<size_t>(scene_.solver.block_max_nodes);
-    update_contact_pattern(cloth.elements, loads.contacts,
-                           cholmod_sized ? ContactReach::kNeighbourhoods : ContactReach::kPairs);
+    update_contact_pattern(cloth.elements, loads.contacts);
     cloth.solver.set_settings(scene_.solver);
     implicit_euler_step(cloth.mesh, cloth.elements, cloth.solver, loads, dt, &times.solver);
   }

@@ -2,12 +2,9 @@
 // CHOLMOD solve, including reuse of the symbolic analysis.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cstdio>
 #include <random>
 
 #include "physics/block_system.hpp"
-#include "support/mesh_factory.hpp"
 
 namespace arcsim {
 namespace {
@@ -280,15 +277,6 @@ TEST(CholeskySolverPcg, AnIndefiniteMatrixStillFailsUnderTheIteration) {
   EXPECT_FALSE(solver.solve_system(bad.system, x, report));
 }
 
-// The node order expanded to scalar rows, as the solver hands it to CHOLMOD.
-std::vector<int> scalar_order(const BlockPattern& pattern) {
-  const std::vector<int> nodes = pattern.fill_reducing_order();
-  std::vector<int> order;
-  for (int node : nodes)
-    for (int c = 0; c < 3; ++c) order.push_back(3 * node + c);
-  return order;
-}
-
 // The solver hands CHOLMOD the permuted lower triangle through a map kept per analysis: its factor must be the
 // one CHOLMOD makes from the upper triangle itself (Eigen's wrapper, same ordering), bit for bit, before and
 // after the values change on the same pattern, and after a new pattern.
@@ -321,57 +309,15 @@ TEST(CholeskySolver, PermutedLayoutGivesCholmodsOwnFactor) {
 
     Eigen::SparseMatrix<double> upper;
     system.to_csc(upper);
-    SupernodalLLT reference;
-    std::vector<int> order = scalar_order(pattern);
-    reference.analyze_in_order(upper, order);
-    reference.factorize(upper);
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> reference;
+    reference.cholmod().nmethods = 1;
+    reference.cholmod().method[0].ordering = CHOLMOD_AMD;
+    reference.compute(upper);
     ASSERT_EQ(reference.info(), Eigen::Success);
     const VecX expected = reference.solve(system.rhs);
     EXPECT_TRUE(ours == expected) << "round " << round << ": " << (ours - expected).norm();
   }
   EXPECT_EQ(solver.analyses(), 2);
-}
-
-// AMD on the node graph, each node's rows kept together, must reduce fill as well as CHOLMOD's AMD on the scalar
-// matrix (which finds the 3x3 structure itself): a sheet's pattern with its bending stencils, factor entries.
-TEST(CholeskySolver, NodeOrderFillsAsLittleAsScalarAmd) {
-  const Mesh sheet = testing::make_grid(24, 24, 1.0, 1.0);
-  std::vector<std::pair<int, int>> pairs;
-  auto node = [&](int v) { return sheet.verts[v].node; };
-  for (const Face& f : sheet.faces)
-    for (int i = 0; i < 3; ++i) pairs.emplace_back(node(f.v[i]), node(f.v[(i + 1) % 3]));
-  for (const Edge& e : sheet.edges) {  // a hinge's two wing nodes
-    if (e.is_boundary()) continue;
-    int wing[2] = {0, 0};
-    for (int s = 0; s < 2; ++s)
-      for (int v : sheet.faces[e.f[s]].v)
-        if (node(v) != e.n[0] && node(v) != e.n[1]) wing[s] = node(v);
-    pairs.emplace_back(wing[0], wing[1]);
-  }
-  const int n = static_cast<int>(sheet.nodes.size());
-  BlockPattern pattern;
-  pattern.build(n, pairs);
-  pattern.prepare_layout();
-  Eigen::SparseMatrix<double> upper = pattern.csc_structure();
-  std::fill(upper.valuePtr(), upper.valuePtr() + upper.nonZeros(), 1.0);
-
-  SupernodalLLT node_ordered;
-  std::vector<int> order = scalar_order(pattern);
-  ASSERT_EQ(static_cast<int>(order.size()), 3 * n);
-  std::vector<int> sorted = order;
-  std::sort(sorted.begin(), sorted.end());
-  for (int k = 0; k < 3 * n; ++k) ASSERT_EQ(sorted[k], k);  // a permutation
-  node_ordered.analyze_in_order(upper, order);
-  const double node_fill = node_ordered.cholmod().lnz;
-
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> scalar_ordered;
-  scalar_ordered.cholmod().nmethods = 1;
-  scalar_ordered.cholmod().method[0].ordering = CHOLMOD_AMD;
-  scalar_ordered.analyzePattern(upper);
-  const double scalar_fill = scalar_ordered.cholmod().lnz;
-  std::printf("factor entries of a %d-node sheet: node AMD %.0f, scalar AMD %.0f\n", n, node_fill, scalar_fill);
-  EXPECT_GT(node_fill, 0);
-  EXPECT_LE(node_fill, 1.05 * scalar_fill);
 }
 
 }  // namespace

@@ -66,7 +66,7 @@ TEST(SystemPremises, AContactWithNegativeStiffnessIsNamed) {
   c.normal = Vec3::UnitZ();
   c.stiffness = -1e9;
   loads.contacts.push_back(c);
-  update_contact_pattern(s.cache, loads.contacts, ContactReach::kPairs);
+  update_contact_pattern(s.cache, loads.contacts);
   const std::string error = step_error(s, loads, 1e-2);
   EXPECT_NE(error.find("contact of nodes 5 0 0 0 has stiffness -1e+09 N/m"), std::string::npos) << error;
 }

@@ -23,7 +23,7 @@ Mesh full_step_with_outside_pinned(const ZoneTestSheet& sheet, const std::vector
     if (!in_zone[n]) loads.pinned[n] = 1;
   ElementCache cache;
   build_element_cache(mesh, sheet.materials, cache);
-  update_contact_pattern(cache, loads.contacts, ContactReach::kPairs);
+  update_contact_pattern(cache, loads.contacts);
   CholeskySolver solver;
   implicit_euler_step(mesh, cache, solver, loads, dt);
   return mesh;
@@ -105,7 +105,7 @@ TEST(ZoneSolve, WholeMeshZoneEqualsFullStep) {
   Mesh full = sheet.mesh;
   ElementCache cache;
   build_element_cache(full, sheet.materials, cache);
-  update_contact_pattern(cache, sheet.loads.contacts, ContactReach::kPairs);
+  update_contact_pattern(cache, sheet.loads.contacts);
   CholeskySolver full_solver;
   const double dt = 2e-3;
   implicit_euler_step(full, cache, full_solver, sheet.loads, dt);
