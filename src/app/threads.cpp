@@ -86,8 +86,10 @@ ThreadGovernor::ThreadGovernor(int threads) {
 
 void ThreadGovernor::frame_done() {
   if (!active_) return;
+  // Frames can be a millisecond long: read the counters only once enough wall time has passed.
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (wall - last_.wall < kMinInterval) return;
   const CpuSample now = sample_cpu();
-  if (now.wall - last_.wall < kMinInterval) return;
   const int team = cores_left_free(last_, now, cores_);
   last_ = now;
   if (team == team_) return;
