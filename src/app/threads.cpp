@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -26,11 +27,16 @@ namespace {
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
 
+// A monotonic wall clock (s).
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 }  // namespace
 
 CpuSample sample_cpu() {
   CpuSample s;
-  s.wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  s.wall = wall_seconds();
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) s.own = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   // Only the CPUs this process may run on (in a container or under taskset the others are someone else's).
@@ -87,8 +93,7 @@ ThreadGovernor::ThreadGovernor(int threads) {
 void ThreadGovernor::frame_done() {
   if (!active_) return;
   // Frames can be a millisecond long: read the counters only once enough wall time has passed.
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  if (wall - last_.wall < kMinInterval) return;
+  if (wall_seconds() - last_.wall < kMinInterval) return;
   const CpuSample now = sample_cpu();
   const int team = cores_left_free(last_, now, cores_);
   last_ = now;

@@ -1,8 +1,6 @@
 // How many OpenMP threads a run uses.
 #pragma once
 
-#include <chrono>
-
 namespace arcsim {
 
 // threads > 0: exactly that many (the user asked). threads == 0: OpenMP's dynamic teams until a
@@ -29,7 +27,7 @@ int cores_left_free(const CpuSample& before, const CpuSample& after, int cores);
 // Sizes the teams of a run whose thread count the user left open, frame by frame. OpenMP's dynamic teams follow
 // the 15-minute load average less 0.1 cores (libgomp), which counts this very process: on a 2-core machine a
 // run of a few minutes, or one started after other work, drops to one thread and stays there with the other
-// core idle (flag.json took 16.6 s instead of 14.9 s). The governor instead measures what other processes used
+// core idle (flag.json's first second took 17.6 s instead of 14.6-15.3 s). The governor instead measures what other processes used
 // during the last frames (at least kMinInterval of wall) and sizes the fixed team from that.
 class ThreadGovernor {
  public:
